@@ -1,0 +1,184 @@
+"""The ``raysim`` command: it only wires (DESIGN.md "Command-line contract").
+
+Bad input of any kind prints one line ``error: <file>: <place>: <what>`` on
+stderr and exits with code 2, leaving nothing behind.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from pathlib import Path
+
+from raysim import __version__
+from raysim.errors import InputError
+
+SENSOR_NAMES = ("lidar", "radar", "ais", "nav")
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str):  # one line, exit 2, like every other bad input
+        raise InputError("command line", self.prog, message)
+
+
+def _duration(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise InputError("command line", "--duration", f"not a number: {text!r}") from None
+    if not (math.isfinite(value) and 0 < value <= 86_400):
+        raise InputError("command line", "--duration", f"must be > 0 and <= 86400 s, got {text}")
+    return value
+
+
+def _seed(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise InputError("command line", "--seed", f"not an integer: {text!r}") from None
+    if value < 0:
+        raise InputError("command line", "--seed", f"must be >= 0, got {value}")
+    return value
+
+
+def _sensors(text: str) -> tuple[str, ...]:
+    names = tuple(n.strip() for n in text.split(",") if n.strip())
+    for name in names:
+        if name not in SENSOR_NAMES:
+            raise InputError("command line", "--sensors", f"unknown sensor {name!r} (known: {', '.join(SENSOR_NAMES)})")
+    if not names:
+        raise InputError("command line", "--sensors", "name at least one sensor")
+    return names
+
+
+def _route(text: str) -> list[list[float]]:
+    points = []
+    for part in text.split(";"):
+        try:
+            lat, lon = (float(v) for v in part.split(","))
+        except ValueError:
+            raise InputError("command line", "--route", f"expected 'lat,lon;lat,lon;...', got {part!r}") from None
+        points.append([lat, lon])
+    return points
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="raysim", description="Physics-based raw sensor renderer for autonomous surface vessels.")
+    parser.add_argument("--version", action="version", version=f"raysim {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    def common(p, sensors: bool):
+        p.add_argument("scenario", type=Path, help="scenario YAML file")
+        p.add_argument("-o", "--out", type=Path, help="recording directory (default: runs/<scenario name>)")
+        p.add_argument("--duration", type=_duration, help="override duration_s")
+        p.add_argument("--seed", type=_seed, help="override the seed")
+        if sensors:
+            p.add_argument("--sensors", type=_sensors, help="comma-separated subset of lidar,radar,ais,nav")
+        p.add_argument("--no-progress", action="store_true", help="no progress bars")
+
+    common(sub.add_parser("render", help="render a scenario into a recording directory"), sensors=True)
+    common(sub.add_parser("run", help="render, then run and evaluate the TDM"), sensors=False)
+
+    imp = sub.add_parser("import-hilsim", help="convert the 2017 HIL simulator's configuration files")
+    imp.add_argument("obstacles", type=Path)
+    imp.add_argument("sensors", type=Path)
+    imp.add_argument("dynamics", type=Path, nargs="?")
+    imp.add_argument("-o", "--out", type=Path, required=True, help="scenario YAML to write")
+    imp.add_argument("--name", default=None, help="scenario name (default: the output file's stem)")
+    imp.add_argument("--route", type=_route, help="own-ship waypoints 'lat,lon;lat,lon;...' (default: lie still at the start)")
+    imp.add_argument("--speed-kn", type=float, default=8.0, help="own-ship speed on the route, knots")
+    imp.add_argument("--duration", type=_duration, default=300.0, help="scenario duration, s")
+
+    bench = sub.add_parser("bench", help="run the benchmarks and print their tables")
+    bench.add_argument("--quick", action="store_true", help="fewer rays and repetitions")
+    bench.add_argument("--json", type=Path, help="also write the results as JSON")
+    return parser
+
+
+def _load(args) -> "Scenario":  # noqa: F821
+    from raysim.scenario import load_scenario, with_overrides
+
+    scenario = load_scenario(args.scenario)
+    return with_overrides(scenario, args.duration, args.seed, getattr(args, "sensors", None))
+
+
+def _out_dir(args, scenario) -> Path:
+    return args.out if args.out is not None else Path("runs") / scenario.name
+
+
+def cmd_render(args) -> int:
+    from raysim.render import render
+
+    scenario = _load(args)
+    out = _out_dir(args, scenario)
+    result = render(scenario, out, progress=False if args.no_progress else None)
+    _summary(result)
+    return 0
+
+
+def cmd_run(args) -> int:
+    from raysim.render import render
+
+    scenario = _load(args)
+    out = _out_dir(args, scenario)
+    result = render(scenario, out, progress=False if args.no_progress else None)
+    _summary(result)
+    return 0
+
+
+def _summary(result) -> None:
+    m = result.manifest
+    counts = ", ".join(f"{k}: {v}" for k, v in m["counts"].items())
+    print(f"rendered {m['scenario']} ({m['duration_s']:g} s, seed {m['seed']}) into {result.out_dir} in {m['wall_time_s']['total']:.1f} s")
+    print(f"  {counts}")
+    if m["sensors_not_available"]:
+        print(f"  not rendered (not implemented in this version): {', '.join(m['sensors_not_available'])}")
+
+
+def cmd_import_hilsim(args) -> int:
+    from raysim.hilsim import import_hilsim, scenario_text
+    from raysim.recording.staging import atomic_path
+    from raysim.scenario import load_scenario
+
+    name = args.name or args.out.stem
+    scenario, comments = import_hilsim(args.obstacles, args.sensors, args.dynamics, name=name, route=args.route,
+                                       speed_kn=args.speed_kn, duration_s=args.duration)
+    files = " ".join(p.name for p in (args.obstacles, args.sensors, args.dynamics) if p is not None)
+    header = [f"Made by `raysim import-hilsim {files}` from the 2017 thesis's configuration files.",
+              "Thesis parameters without a native key are kept as comments below."]
+    text = scenario_text(scenario, comments, header)
+    with atomic_path(args.out) as tmp:
+        tmp.write_text(text, encoding="utf-8")
+        try:
+            load_scenario(tmp)  # the result must be a valid scenario
+        except InputError as exc:
+            raise InputError(exc.file.replace(tmp.name, args.out.name), exc.where, exc.what) from None
+    print(f"wrote {args.out}: {len(scenario['obstacles'])} obstacles, {len(scenario['ships'])} ships")
+    return 0
+
+
+def cmd_bench(args) -> int:
+    from raysim import benchmarking
+
+    return benchmarking.main(quick=args.quick, json_path=args.json)
+
+
+COMMANDS = {"render": cmd_render, "run": cmd_run, "import-hilsim": cmd_import_hilsim, "bench": cmd_bench}
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``raysim`` console script."""
+    try:
+        args = build_parser().parse_args(argv)
+        return COMMANDS[args.command](args)
+    except InputError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("error: interrupted; nothing was written", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

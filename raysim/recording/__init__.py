@@ -1,0 +1,1 @@
+"""Recording writers: they only serialise; physics lives in sensors and the scene."""

@@ -1,0 +1,186 @@
+"""Render a scenario into a recording directory (DESIGN.md "Recording directory contract").
+
+The pipeline: build the world (meshes, motions), then stream each product chunk
+by chunk into a staged directory that is moved into place only when everything
+succeeded. Sensors plug in through :data:`SENSOR_RENDERERS`.
+"""
+
+from __future__ import annotations
+
+import json
+import platform
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+from tqdm import tqdm
+
+from raysim import __version__
+from raysim.pose import heading_deg_from_yaw
+from raysim.recording.jsonl import course_and_speed, write_ownship_chunk, write_truth_chunk
+from raysim.recording.staging import MANIFEST, StagedDirectory, atomic_path
+from raysim.scenario import Scenario, scenario_to_yaml
+from raysim.world import World
+
+TRUTH_RATE_HZ = 10.0  # DESIGN.md: one truth line per object per 0.1 s
+CHUNK_S = 30.0  # seconds of truth / navigation formatted at a time (memory stays flat)
+
+
+@dataclass
+class RenderContext:
+    """What a sensor renderer gets: the world, the staging directory, and where to report."""
+
+    world: World
+    out_dir: Path
+    progress: bool
+    counts: dict = field(default_factory=dict)
+    wall_time_s: dict = field(default_factory=dict)
+
+
+#: Sensor name -> renderer(context). Sensors register here as they are implemented.
+SENSOR_RENDERERS: dict[str, Callable[[RenderContext], None]] = {}
+
+
+@dataclass(frozen=True)
+class RenderResult:
+    out_dir: Path
+    manifest: dict
+
+
+def _ticks(duration_s: float, rate_hz: float) -> np.ndarray:
+    """Times k / rate for k = 0 .. floor(duration * rate), without accumulated rounding."""
+    n = int(np.floor(duration_s * rate_hz + 1e-9)) + 1
+    return np.arange(n) / rate_hz
+
+
+def _chunks(t_s: np.ndarray, rate_hz: float):
+    step = max(1, int(CHUNK_S * rate_hz))
+    for start in range(0, t_s.shape[0], step):
+        yield t_s[start : start + step]
+
+
+def write_truth(world: World, path: Path, progress: bool) -> int:
+    """Write truth.jsonl: every object at 10 Hz. Returns the number of lines."""
+    t_all = _ticks(world.scenario.duration_s, TRUTH_RATE_HZ)
+    lines = 0
+    with atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8", newline="\n") as handle:
+        for t in tqdm(list(_chunks(t_all, TRUTH_RATE_HZ)), desc="truth", unit="chunk", disable=not progress, leave=False):
+            per_object = []
+            for o in world.objects:
+                poses = o.motion.poses(t)
+                lat, lon = world.frame.to_geodetic(poses.position_m[:, 0], poses.position_m[:, 1])
+                cog, sog = course_and_speed(o.motion.velocity_mps(t), poses.yaw_rad)
+                per_object.append(dict(
+                    id=o.object_id, name=o.name, kind=o.kind, length_m=o.length_m, beam_m=o.beam_m, height_m=o.height_m,
+                    ais=bool(o.ais is not None and o.ais.enabled), mmsi=o.ais.mmsi if o.ais is not None else None,
+                    lat=lat, lon=lon, x=poses.position_m[:, 0], y=poses.position_m[:, 1],
+                    heading_deg=heading_deg_from_yaw(poses.yaw_rad), cog_deg=cog, sog_mps=sog,
+                ))
+            lines += write_truth_chunk(handle, t, per_object)
+    return lines
+
+
+def write_ownship(world: World, path: Path, progress: bool) -> int:
+    """Write ownship.jsonl at the navigation rate. Returns the number of lines."""
+    rate = world.scenario.sensors.nav.rate_hz
+    t_all = _ticks(world.scenario.duration_s, rate)
+    motion = world.own_ship.motion
+    lines = 0
+    with atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8", newline="\n") as handle:
+        for t in tqdm(list(_chunks(t_all, rate)), desc="ownship", unit="chunk", disable=not progress, leave=False):
+            poses = motion.poses(t)
+            lat, lon = world.frame.to_geodetic(poses.position_m[:, 0], poses.position_m[:, 1])
+            cog, sog = course_and_speed(motion.velocity_mps(t), poses.yaw_rad)
+            columns = dict(
+                lat=lat, lon=lon, x=poses.position_m[:, 0], y=poses.position_m[:, 1], z=poses.position_m[:, 2],
+                heading_deg=heading_deg_from_yaw(poses.yaw_rad), roll_deg=np.degrees(poses.roll_rad),
+                pitch_deg=-np.degrees(poses.pitch_rad), cog_deg=cog, sog_mps=sog,
+            )
+            lines += write_ownship_chunk(handle, t, columns)
+    return lines
+
+
+def _versions() -> dict:
+    import numpy
+    import pyproj
+    import trimesh
+
+    versions = {"raysim": __version__, "python": platform.python_version(), "numpy": numpy.__version__,
+                "pyproj": pyproj.__version__, "trimesh": trimesh.__version__}
+    try:
+        import open3d
+
+        versions["open3d"] = open3d.__version__
+    except ImportError:  # pragma: no cover - open3d is a hard dependency
+        pass
+    return versions
+
+
+def render(scenario: Scenario, out_dir: Path, progress: bool | None = None) -> RenderResult:
+    """Render ``scenario`` into ``out_dir``; all or nothing.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Resolved scenario (overrides applied).
+    out_dir : Path
+        Recording directory; replaced if it holds an older recording.
+    progress : bool, optional
+        Show progress bars; default: when stderr is a terminal.
+    """
+    if progress is None:
+        progress = sys.stderr.isatty()
+    started = time.perf_counter()
+    wall: dict[str, float] = {}
+    t0 = time.perf_counter()
+    world = World(scenario)
+    wall["world"] = time.perf_counter() - t0
+    enabled = scenario.sensors.enabled_names()
+    with StagedDirectory(Path(out_dir)) as staged:
+        ctx = RenderContext(world, staged.path, progress, wall_time_s=wall)
+        with atomic_path(staged.path / "scenario.yaml") as tmp:
+            tmp.write_text(scenario_to_yaml(scenario), encoding="utf-8")
+        t0 = time.perf_counter()
+        ctx.counts["truth.jsonl"] = write_truth(world, staged.path / "truth.jsonl", progress)
+        wall["truth"] = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        ctx.counts["ownship.jsonl"] = write_ownship(world, staged.path / "ownship.jsonl", progress)
+        wall["ownship"] = time.perf_counter() - t0
+        rendered, not_available = [], []
+        for name in enabled:
+            renderer = SENSOR_RENDERERS.get(name)
+            if renderer is None:
+                not_available.append(name)
+                continue
+            t0 = time.perf_counter()
+            renderer(ctx)
+            wall[name] = time.perf_counter() - t0
+            rendered.append(name)
+        wall["total"] = time.perf_counter() - started
+        manifest = {
+            "format": "raysim-recording",
+            "format_version": 1,
+            "scenario": scenario.name,
+            "seed": scenario.seed,
+            "start_time": scenario_to_yaml_time(scenario),
+            "duration_s": scenario.duration_s,
+            "sensors_enabled": list(enabled),
+            "sensors_rendered": rendered,
+            "sensors_not_available": not_available,
+            "objects": [{"id": o.object_id, "name": o.name, "kind": o.kind} for o in world.objects],
+            "counts": dict(sorted(ctx.counts.items())),
+            "versions": _versions(),
+            "wall_time_s": {k: round(v, 3) for k, v in wall.items()},
+        }
+        with atomic_path(staged.path / MANIFEST) as tmp:
+            tmp.write_text(json.dumps(manifest, indent=2) + "\n", encoding="utf-8")
+        staged.commit()
+    return RenderResult(Path(out_dir), manifest)
+
+
+def scenario_to_yaml_time(scenario: Scenario) -> str:
+    """The scenario's start time as ISO 8601 UTC with a Z."""
+    return scenario.start_time.strftime("%Y-%m-%dT%H:%M:%S.%fZ").replace(".000000Z", "Z")

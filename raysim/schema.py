@@ -1,0 +1,286 @@
+"""Strict conversion of parsed YAML into typed, frozen dataclasses.
+
+A schema is a dataclass whose fields carry metadata made by :func:`param`:
+a documentation line, a unit-bearing name, bounds and an optional check.
+:func:`build` walks the YAML tree, rejects unknown keys, wrong types, NaN/inf
+and out-of-range values, and raises :class:`raysim.errors.InputError` naming the
+key path (``ships[1].ais.mmsi``). :func:`to_plain` turns a built object back
+into plain YAML-able data, and :func:`describe` lists every field with its
+default for the documentation.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import datetime as dt
+import math
+import types
+import typing
+from pathlib import Path
+from typing import Any, Callable, Literal, get_args, get_origin
+
+from raysim.errors import InputError
+
+DERIVED = "derived"  # doc marker for defaults computed from other fields
+
+_MISSING = dataclasses.MISSING
+
+
+def param(
+    default: Any = _MISSING,
+    *,
+    doc: str,
+    ge: float | None = None,
+    gt: float | None = None,
+    le: float | None = None,
+    lt: float | None = None,
+    min_items: int | None = None,
+    check: Callable[[Any], str | None] | None = None,
+    default_doc: str | None = None,
+    default_factory: Callable[[], Any] | None = None,
+) -> Any:
+    """A schema field.
+
+    Parameters
+    ----------
+    default : optional
+        Default value; leave out for a required key. ``None`` with ``default_doc``
+        marks a default derived from other fields at resolve time.
+    doc : str
+        One-line description (goes into docs/scenario.md).
+    ge, gt, le, lt : float, optional
+        Inclusive / exclusive bounds for numbers (and for each number in a list).
+    min_items : int, optional
+        Minimum length of a list.
+    check : callable, optional
+        ``check(value) -> message or None`` for anything else.
+    default_doc : str, optional
+        How the default is derived, when it is not a constant.
+    """
+    meta = dict(doc=doc, ge=ge, gt=gt, le=le, lt=lt, min_items=min_items, check=check, default_doc=default_doc)
+    if default_factory is not None:
+        return dataclasses.field(default_factory=default_factory, metadata=meta)
+    return dataclasses.field(default=default, metadata=meta)
+
+
+class Context:
+    """Where the YAML came from: the file (for error messages) and its folder (for relative paths)."""
+
+    def __init__(self, file: str | Path):
+        self.file = str(file)
+        self.base_dir = Path(file).resolve().parent
+
+    def fail(self, where: str, what: str) -> typing.NoReturn:
+        raise InputError(self.file, where or "(top level)", what)
+
+
+def _type_name(value: Any) -> str:
+    if value is None:
+        return "null"
+    if isinstance(value, bool):
+        return "a boolean"
+    if isinstance(value, (int, float)):
+        return f"the number {value!r}"
+    if isinstance(value, str):
+        return f"the string {value!r}"
+    if isinstance(value, list):
+        return "a list"
+    if isinstance(value, dict):
+        return "a mapping"
+    return type(value).__name__
+
+
+def _child(path: str, key: str | int) -> str:
+    if isinstance(key, int):
+        return f"{path}[{key}]"
+    return f"{path}.{key}" if path else key
+
+
+def _check_number(value: float, meta: dict, ctx: Context, path: str) -> None:
+    if not math.isfinite(value):
+        ctx.fail(path, f"must be a finite number, got {value!r}")
+    for key, ok, word in (
+        ("ge", lambda v, b: v >= b, ">="),
+        ("gt", lambda v, b: v > b, ">"),
+        ("le", lambda v, b: v <= b, "<="),
+        ("lt", lambda v, b: v < b, "<"),
+    ):
+        bound = meta.get(key)
+        if bound is not None and not ok(value, bound):
+            ctx.fail(path, f"must be {word} {bound:g}, got {value:g}")
+
+
+def _convert(tp: Any, value: Any, meta: dict, ctx: Context, path: str) -> Any:
+    origin = get_origin(tp)
+    args = get_args(tp)
+    if origin in (typing.Union, types.UnionType):
+        if value is None and type(None) in args:
+            return None
+        inner = [a for a in args if a is not type(None)]
+        if value is None:
+            ctx.fail(path, "must not be null")
+        if len(inner) == 1:
+            return _convert(inner[0], value, meta, ctx, path)
+        errors = []
+        for candidate in inner:
+            try:
+                return _convert(candidate, value, meta, ctx, path)
+            except InputError as exc:
+                errors.append(exc.what)
+        ctx.fail(path, errors[-1])
+    if origin is Literal:
+        if value not in args:
+            allowed = ", ".join(repr(a) for a in args)
+            ctx.fail(path, f"must be one of {allowed}, got {_type_name(value)}")
+        return value
+    if dataclasses.is_dataclass(tp):
+        return build(tp, value, ctx, path)
+    if origin in (list, tuple):
+        if not isinstance(value, list):
+            ctx.fail(path, f"must be a list, got {_type_name(value)}")
+        if origin is tuple and args and args[-1] is not Ellipsis:
+            if len(value) != len(args):
+                ctx.fail(path, f"must be a list of {len(args)} items, got {len(value)}")
+            items = [_convert(a, v, meta, ctx, _child(path, i)) for i, (a, v) in enumerate(zip(args, value))]
+        else:
+            item_tp = args[0] if args else Any
+            if meta.get("min_items") is not None and len(value) < meta["min_items"]:
+                ctx.fail(path, f"must have at least {meta['min_items']} item(s), got {len(value)}")
+            items = [_convert(item_tp, v, meta, ctx, _child(path, i)) for i, v in enumerate(value)]
+        return tuple(items)
+    if tp is bool:
+        if not isinstance(value, bool):
+            ctx.fail(path, f"must be true or false, got {_type_name(value)}")
+        return value
+    if tp is int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            ctx.fail(path, f"must be an integer, got {_type_name(value)}")
+        _check_number(value, meta, ctx, path)
+        return value
+    if tp is float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            ctx.fail(path, f"must be a number, got {_type_name(value)}")
+        _check_number(float(value), meta, ctx, path)
+        return float(value)
+    if tp is str:
+        if not isinstance(value, str) or not value.strip():
+            ctx.fail(path, f"must be a non-empty string, got {_type_name(value)}")
+        return value
+    if tp is Path:
+        if not isinstance(value, str) or not value.strip():
+            ctx.fail(path, f"must be a file path, got {_type_name(value)}")
+        return (ctx.base_dir / value).resolve()
+    if tp is dt.datetime:
+        if isinstance(value, str):
+            try:
+                value = dt.datetime.fromisoformat(value.replace("Z", "+00:00"))
+            except ValueError:
+                ctx.fail(path, f"must be an ISO 8601 UTC time such as 2017-06-01T12:00:00Z, got {value!r}")
+        if not isinstance(value, dt.datetime):
+            ctx.fail(path, f"must be an ISO 8601 UTC time such as 2017-06-01T12:00:00Z, got {_type_name(value)}")
+        if value.tzinfo is None:
+            value = value.replace(tzinfo=dt.timezone.utc)
+        return value.astimezone(dt.timezone.utc)
+    if tp is Any:
+        return value
+    raise TypeError(f"schema type {tp!r} at {path} is not supported")  # a bug in a schema, not bad input
+
+
+def build(cls: type, data: Any, ctx: Context, path: str = "") -> Any:
+    """Build the dataclass ``cls`` from parsed YAML ``data``, strictly.
+
+    Raises
+    ------
+    InputError
+        Naming ``ctx.file``, the key path and what is wrong.
+    """
+    if data is None:
+        data = {}
+    if not isinstance(data, dict):
+        ctx.fail(path, f"must be a mapping of keys to values, got {_type_name(data)}")
+    hints = typing.get_type_hints(cls)
+    fields = {f.name: f for f in dataclasses.fields(cls) if f.init}
+    for key in data:
+        if key not in fields:
+            allowed = ", ".join(fields)
+            ctx.fail(_child(path, str(key)), f"unknown key (allowed here: {allowed})")
+    values = {}
+    for name, f in fields.items():
+        sub = _child(path, name)
+        if name in data:
+            values[name] = _convert(hints[name], data[name], dict(f.metadata), ctx, sub)
+            check = f.metadata.get("check")
+            if check is not None and values[name] is not None:
+                message = check(values[name])
+                if message:
+                    ctx.fail(sub, message)
+        elif f.default is _MISSING and f.default_factory is _MISSING:
+            ctx.fail(sub, "required key is missing")
+    return cls(**values)
+
+
+def to_plain(obj: Any) -> Any:
+    """Plain YAML-able data (dicts, lists, numbers, strings) from a built object."""
+    if dataclasses.is_dataclass(obj):
+        return {f.name: to_plain(getattr(obj, f.name)) for f in dataclasses.fields(obj) if f.init}
+    if isinstance(obj, (list, tuple)):
+        return [to_plain(v) for v in obj]
+    if isinstance(obj, Path):
+        return str(obj)
+    if isinstance(obj, dt.datetime):
+        return obj.astimezone(dt.timezone.utc).strftime("%Y-%m-%dT%H:%M:%S.%fZ").replace(".000000Z", "Z")
+    if isinstance(obj, float) and obj.is_integer() and abs(obj) < 1e15:
+        return obj  # keep floats as floats (YAML writes 10.0)
+    return obj
+
+
+def describe(cls: type, path: str = "") -> list[tuple[str, str, str, str]]:
+    """Rows ``(key path, type, default, doc)`` for every field of a schema, recursively."""
+    rows = []
+    hints = typing.get_type_hints(cls)
+    for f in dataclasses.fields(cls):
+        if not f.init:
+            continue
+        sub = _child(path, f.name)
+        tp = hints[f.name]
+        inner = [a for a in get_args(tp) if a is not type(None)] if get_origin(tp) in (typing.Union, types.UnionType) else [tp]
+        if f.metadata.get("default_doc"):
+            default = f.metadata["default_doc"]
+        elif f.default is not _MISSING:
+            default = "null" if f.default is None else repr(to_plain(f.default))
+        elif f.default_factory is not _MISSING:
+            value = f.default_factory()
+            default = "(see below)" if dataclasses.is_dataclass(value) else repr(to_plain(value))
+        else:
+            default = "required"
+        rows.append((sub, _describe_type(tp), default, f.metadata.get("doc", "")))
+        for candidate in inner:
+            if dataclasses.is_dataclass(candidate):
+                rows.extend(describe(candidate, sub))
+            elif get_origin(candidate) in (list, tuple):
+                item = get_args(candidate)[0] if get_args(candidate) else None
+                if item is not None and dataclasses.is_dataclass(item):
+                    rows.extend(describe(item, sub + "[]"))
+    return rows
+
+
+def _describe_type(tp: Any) -> str:
+    origin = get_origin(tp)
+    args = get_args(tp)
+    if origin in (typing.Union, types.UnionType):
+        return " or ".join(_describe_type(a) for a in args)
+    if origin is Literal:
+        return " / ".join(repr(a) for a in args)
+    if origin in (list, tuple):
+        if origin is tuple and args and args[-1] is not Ellipsis:
+            return "[" + ", ".join(_describe_type(a) for a in args) + "]"
+        return "list of " + _describe_type(args[0]) if args else "list"
+    if dataclasses.is_dataclass(tp):
+        return "mapping"
+    if tp is type(None):
+        return "null"
+    if tp is Path:
+        return "path"
+    if tp is dt.datetime:
+        return "UTC time"
+    return getattr(tp, "__name__", str(tp))

@@ -1,0 +1,186 @@
+"""The scenario turned into a world: objects with ids, meshes and motions.
+
+Truth ids are stable: the own ship is 0, then the obstacles in file order, then
+the ships in file order. Every object carries a :class:`raysim.meshes.BodyMesh`
+(body frame) and a :class:`raysim.motion.Motion`; :meth:`World.scene_objects`
+hands them to the ray engine.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from raysim import meshes
+from raysim.errors import InputError
+from raysim.geodesy import LocalFrame
+from raysim.motion import Motion, SampledTrack, ShipMotion, Stationary, WaveMotion, TRACK_DT_S, waypoint_track
+from raysim.pose import yaw_from_heading_deg
+from raysim.random_streams import stream
+from raysim.scenario import Scenario, ShipAis, WaveMotion as WaveMotionConfig
+from raysim.trajectory_csv import read_trajectory_csv
+
+KNOT_MPS = 1852.0 / 3600.0  # REFERENCE.md section 1
+
+
+@dataclass(frozen=True)
+class WorldObject:
+    """One object of the world.
+
+    Attributes
+    ----------
+    object_id : int
+        Truth id (own ship 0).
+    name, kind : str
+        Kind is ``ownship``, ``ship``, ``iceberg``, ``buoy`` or ``mesh``.
+    mesh : raysim.meshes.BodyMesh
+        Geometry in the body frame.
+    motion : raysim.motion.Motion
+        Pose for any times.
+    length_m, beam_m, height_m : float
+        Dimensions for truth (above-water extents of the mesh, or the configured hull size).
+    ais : ShipAis or None
+        Transponder configuration, if any.
+    key_path : str
+        Where the object is in the scenario file (for messages).
+    """
+
+    object_id: int
+    name: str
+    kind: str
+    mesh: meshes.BodyMesh
+    motion: Motion
+    length_m: float
+    beam_m: float
+    height_m: float
+    ais: ShipAis | None
+    key_path: str
+
+
+class World:
+    """Objects, motions and the local frame of a resolved scenario.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        A resolved scenario (:func:`raysim.scenario.load_scenario`).
+    """
+
+    def __init__(self, scenario: Scenario):
+        self.scenario = scenario
+        self.frame = LocalFrame(scenario.origin.lat, scenario.origin.lon)
+        self._mesh_cache: dict = {}
+        objects = [self._own_ship()]
+        for i, obstacle in enumerate(scenario.obstacles):
+            objects.append(self._obstacle(len(objects), i, obstacle))
+        for i, ship in enumerate(scenario.ships):
+            objects.append(self._ship(len(objects), i, ship))
+        self.objects: tuple[WorldObject, ...] = tuple(objects)
+
+    @property
+    def own_ship(self) -> WorldObject:
+        return self.objects[0]
+
+    def scene_objects(self) -> list["SceneObject"]:  # noqa: F821
+        """The objects as the ray engine wants them."""
+        from raysim.scene import SceneObject
+
+        return [SceneObject(o.object_id, o.mesh.vertices_m, o.mesh.faces, o.mesh.face_material, o.motion) for o in self.objects]
+
+    # ------------------------------------------------------------------ builders
+
+    def _xy(self, lat_lon) -> np.ndarray:
+        lat_lon = np.asarray(lat_lon, dtype=float).reshape(-1, 2)
+        x, y = self.frame.to_local(lat_lon[:, 0], lat_lon[:, 1])
+        return np.stack([x, y], axis=1)
+
+    def _load(self, path: Path, material: str, where: str) -> meshes.BodyMesh:
+        key = ("file", str(path), material)
+        if key not in self._mesh_cache:
+            try:
+                self._mesh_cache[key] = meshes.load_mesh(path, material=material)
+            except meshes.MeshError as exc:
+                raise InputError(self.scenario.source_file or "scenario", where, f"{path}: {exc.message}") from None
+        return self._mesh_cache[key]
+
+    def _waves(self, cfg: WaveMotionConfig, name: str) -> WaveMotion:
+        return WaveMotion(
+            cfg.roll_amplitude_deg, cfg.roll_period_s, cfg.pitch_amplitude_deg, cfg.pitch_period_s,
+            cfg.heave_amplitude_m, cfg.heave_period_s, stream(self.scenario.seed, f"{name}.waves"),
+        )
+
+    def _own_ship(self) -> WorldObject:
+        s = self.scenario
+        own = s.own_ship
+        waves = self._waves(own.motion, "own_ship")
+        if own.route is not None:
+            track = waypoint_track(
+                self._xy(own.route.waypoints), own.route.speed_kn * KNOT_MPS, s.duration_s,
+                own.route.heading_time_constant_s, own.route.at_end,
+            )
+        elif own.trajectory_csv is not None:
+            track, carries_attitude = self._csv_track(own.trajectory_csv)
+            if carries_attitude:
+                waves = None  # the file's own roll/pitch/heave replace the wave model
+        else:
+            xy = self._xy(own.position)[0]
+            yaw = float(yaw_from_heading_deg(own.heading_deg))
+            track = SampledTrack(TRACK_DT_S, xy[:1], xy[1:], np.array([yaw]), speed_mps=np.zeros(1), yaw_rate_rps=np.zeros(1))
+        if own.mesh is not None:
+            mesh = self._load(own.mesh, own.material, "own_ship.mesh")
+        else:
+            mesh = meshes.own_ship(own.length_m, own.beam_m)
+        length, beam, height = mesh.extents_above_water_m()
+        return WorldObject(0, own.name, "ownship", mesh, ShipMotion(track, waves), length, beam, height, None, "own_ship")
+
+    def _csv_track(self, path: Path) -> tuple[SampledTrack, bool]:
+        """The trajectory file resampled on the track grid, and whether it carries roll/pitch/heave."""
+        table = read_trajectory_csv(path)
+        t = np.arange(0.0, table.t_s[-1] + 0.5 * TRACK_DT_S, TRACK_DT_S)
+        x, y = self.frame.to_local(table.lat_deg, table.lon_deg)
+        yaw = np.unwrap(yaw_from_heading_deg(table.heading_deg))
+        interp = lambda col: None if col is None else np.interp(t, table.t_s, col)  # noqa: E731
+        pitch = interp(table.pitch_deg)
+        track = SampledTrack(
+            TRACK_DT_S, np.interp(t, table.t_s, x), np.interp(t, table.t_s, y), np.interp(t, table.t_s, yaw),
+            roll_rad=None if table.roll_deg is None else np.radians(interp(table.roll_deg)),
+            pitch_rad=None if pitch is None else -np.radians(pitch),
+            z_m=interp(table.heave_m),
+        )
+        return track, any(c is not None for c in (table.roll_deg, table.pitch_deg, table.heave_m))
+
+    def _obstacle(self, object_id: int, index: int, o) -> WorldObject:
+        where = f"obstacles[{index}]"
+        xy = self._xy(o.position)[0]
+        motion = Stationary([xy[0], xy[1], 0.0], float(yaw_from_heading_deg(o.heading_deg)))
+        if o.kind == "iceberg":
+            mesh = meshes.iceberg(o.radius_m, o.height_m, o.seed)
+        elif o.kind == "buoy":
+            key = ("buoy",)
+            mesh = self._mesh_cache.setdefault(key, meshes.buoy())
+        else:
+            mesh = self._load(o.mesh, o.material, where + ".mesh")
+        length, beam, height = mesh.extents_above_water_m()
+        return WorldObject(object_id, o.name, o.kind, mesh, motion, length, beam, height, None, where)
+
+    def _ship(self, object_id: int, index: int, ship) -> WorldObject:
+        where = f"ships[{index}]"
+        s = self.scenario
+        track = waypoint_track(
+            self._xy(ship.waypoints), ship.speed_kn * KNOT_MPS, s.duration_s, ship.heading_time_constant_s,
+            ship.at_end, heading_rad=float(yaw_from_heading_deg(ship.heading_deg)),
+        )
+        if ship.mesh is not None:
+            mesh = self._load(ship.mesh, ship.material, where + ".mesh")
+            length, beam, height = mesh.extents_above_water_m()
+        else:
+            key = ("hull", ship.length_m, ship.beam_m)
+            if key not in self._mesh_cache:
+                self._mesh_cache[key] = meshes.ship_hull(ship.length_m, ship.beam_m)
+            mesh = self._mesh_cache[key]
+            _, _, height = mesh.extents_above_water_m()
+            length, beam = ship.length_m, ship.beam_m
+        return WorldObject(object_id, ship.name, "ship", mesh, ShipMotion(track), length, beam, height, ship.ais, where)
+
