@@ -145,6 +145,9 @@ def cmd_import_hilsim(args) -> int:
     scenario, comments = import_hilsim(args.obstacles, args.sensors, args.dynamics, name=name, route=args.route,
                                        speed_kn=args.speed_kn, duration_s=args.duration)
     files = " ".join(p.name for p in (args.obstacles, args.sensors, args.dynamics) if p is not None)
+    if args.route:
+        route = ";".join(f"{lat:.6f},{lon:.6f}" for lat, lon in args.route)
+        files += f' --route "{route}" --speed-kn {args.speed_kn:g}'
     header = [f"Made by `raysim import-hilsim {files}` from the 2017 thesis's configuration files.",
               "Thesis parameters without a native key are kept as comments below."]
     text = scenario_text(scenario, comments, header)

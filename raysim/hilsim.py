@@ -245,8 +245,12 @@ def import_hilsim(obstacles_path: Path, sensors_path: Path, dynamics_path: Path 
     own: dict = {"name": "odin", "length_m": 10.9, "beam_m": 3.5}
     if route:
         waypoints = [[float(a), float(b)] for a, b in route]
-        if start is not None and waypoints[0] != start:
-            waypoints.insert(0, start)
+        if start is not None:
+            # the route starts at the thesis's start position (a first point within ~1 m of it is replaced)
+            if abs(waypoints[0][0] - start[0]) < 1e-5 and abs(waypoints[0][1] - start[1]) < 2e-5:
+                waypoints[0] = start
+            else:
+                waypoints.insert(0, start)
         own["route"] = {"speed_kn": float(speed_kn), "waypoints": waypoints}
     elif start is not None:
         own["position"] = start

@@ -245,7 +245,7 @@ class Ship:
     at_end: Literal["continue", "stop", "loop"] = param("continue", doc="After the last waypoint: keep course, stop, or loop")
     heading_time_constant_s: float | None = param(None, doc="First-order heading response time constant, s", gt=0, le=600, default_doc="0.1 s/m x length_m, clipped to [2, 60] s")
     mesh: Path | None = param(None, doc="Mesh file (body frame, metres); null = generated hull of length_m", check=_file_check)
-    material: str = param("steel_painted", doc="Material of a mesh file's faces")
+    material: str | None = param(None, doc="Material of a mesh file's faces (generated hulls: steel, GRP under 15 m)", default_doc="steel_painted (mesh)")
     ais: ShipAis | None = param(None, doc="AIS transponder; null = none")
 
 
@@ -364,7 +364,10 @@ def _validate(s: Scenario, ctx: Context) -> None:
     for i, ship in enumerate(s.ships):
         where = f"ships[{i}]"
         _check_unique(ctx, names, ship.name, where + ".name")
-        _check_material(ctx, where + ".material", ship.material, materials)
+        if ship.material is not None:
+            if ship.mesh is None:
+                ctx.fail(where + ".material", "only applies to a ship with a mesh file (generated hulls bring their own)")
+            _check_material(ctx, where + ".material", ship.material, materials)
         if ship.ais is not None:
             if ship.ais.mmsi in mmsis:
                 ctx.fail(where + ".ais.mmsi", f"MMSI {ship.ais.mmsi} is already used by {mmsis[ship.ais.mmsi]}")
@@ -490,6 +493,7 @@ def resolve(s: Scenario) -> Scenario:
             dataclasses.replace(
                 ship,
                 beam_m=ship.beam_m if ship.beam_m is not None else default_beam_m(ship.length_m),
+                material=ship.material if ship.material is not None or ship.mesh is None else "steel_painted",
                 heading_deg=heading,
                 heading_time_constant_s=ship.heading_time_constant_s
                 if ship.heading_time_constant_s is not None
