@@ -289,3 +289,18 @@ def material_table() -> dict[str, np.ndarray]:
         ),
         "specular_exponent": np.array([m.specular_exponent for m in MATERIALS], dtype=np.float32),
     }
+
+
+def describe_markdown() -> str:
+    """Markdown table of the material table with sources (docs/physics.md embeds it)."""
+    lines = [
+        "| index | material | reflectance 905 nm | retro | permittivity | radar dB | specular n | source |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for i, m in enumerate(MATERIALS):
+        er = "-" if m.relative_permittivity is None else f"{m.relative_permittivity:g}"
+        lines.append(
+            f"| {i} | `{m.name}` | {m.reflectance_905nm:.2f} | {'yes' if m.retroreflective else 'no'} | {er} | "
+            f"{m.radar_reflectivity_db:.2f} | {m.specular_exponent:.1f} | {m.source} |"
+        )
+    return "\n".join(lines) + "\n"

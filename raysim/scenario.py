@@ -427,8 +427,10 @@ def heading_time_constant_s(length_m: float) -> float:
 
 
 def default_beam_m(length_m: float) -> float:
-    """Default beam from length (same rule as the generated hulls of raysim.meshes)."""
-    return round(length_m / (3.2 + 0.03 * length_m), 2)
+    """Default beam from length: the generated hulls' rule (:func:`raysim.meshes.default_beam_m`), to 1 cm."""
+    from raysim.meshes import default_beam_m as hull_beam_m
+
+    return round(hull_beam_m(length_m), 2)
 
 
 def _leg_course_deg(waypoints: tuple[LatLon, ...], frame) -> float | None:

@@ -138,3 +138,12 @@ def test_materials_are_frozen_and_sourced():
         assert material.source.strip()
     assert "unverified" in by_name("snow").source
     assert "HELIOS" in by_name("aluminium").source
+
+
+def test_physics_doc_lists_the_material_table():
+    from pathlib import Path
+
+    from raysim.materials import describe_markdown
+
+    doc = (Path(__file__).resolve().parents[2] / "docs" / "physics.md").read_text(encoding="utf-8")
+    assert describe_markdown() in doc, "docs/physics.md is out of date: paste raysim.materials.describe_markdown()"
