@@ -38,10 +38,26 @@ class RenderContext:
     progress: bool
     counts: dict = field(default_factory=dict)
     wall_time_s: dict = field(default_factory=dict)
+    _scene: object = None
+
+    def scene(self):
+        """The ray engine over the world (built once, shared by the sensors)."""
+        if self._scene is None:
+            from raysim.materials import material_index
+            from raysim.scene import Scene
+
+            self._scene = Scene(self.world.scene_objects(), sea=True, sea_material=material_index("sea"))
+        return self._scene
+
+
+def _render_lidar(ctx: "RenderContext") -> None:
+    from raysim.sensors.lidar import render_lidar
+
+    render_lidar(ctx)
 
 
 #: Sensor name -> renderer(context). Sensors register here as they are implemented.
-SENSOR_RENDERERS: dict[str, Callable[[RenderContext], None]] = {}
+SENSOR_RENDERERS: dict[str, Callable[[RenderContext], None]] = {"lidar": _render_lidar}
 
 
 @dataclass(frozen=True)

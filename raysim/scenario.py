@@ -148,6 +148,14 @@ class Lidar:
     model: Literal["HDL-32E"] = param("HDL-32E", doc="LiDAR model")
     rotation_hz: float = param(10.0, doc="Head rotation rate, Hz (HDL-32E: 5-20)", ge=5, le=20)
     range_max_m: float = param(100.0, doc="Maximum range, m (HDL-32E: 100 m; encoding limit 131.07 m)", gt=0, le=131.07)
+    range_min_m: float = param(0.05, doc="Minimum range, m (HDL-32E returns from 5 cm; drivers often cut at 0.9 m)", ge=0, le=10)
+    range_noise_m: float = param(0.008, doc="Range noise, 1 sigma, m (simulators use 0.007-0.008 m)", ge=0, le=1)
+    return_mode: Literal["strongest", "last", "dual"] = param("strongest", doc="Return mode of the packets")
+    detection_reflectance: float = param(0.10, doc="Apparent reflectance just detected at 100 m in clear air (link budget; unverified)", gt=0, le=1)
+    beam_divergence_mrad: float = param(3.0, doc="Full beam divergence, mrad (Chrono uses 3 mrad; no official figure)", ge=0, le=50)
+    sub_rays: Literal[1, 7, 19] = param(1, doc="Rays per beam: 1 = the beam axis only; 7 or 19 sample the divergence cone (edges give dual returns)")
+    azimuth0_deg: float = param(0.0, doc="Head azimuth at t = 0, deg", ge=0, lt=360)
+    position_packet_rate_hz: float = param(1.0, doc="Position packets (UDP 8308) per second (unverified)", ge=0, le=100)
     mount: Mount = param(default_factory=Mount, doc="Mounting on the own ship (body frame)")
 
 

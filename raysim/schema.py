@@ -129,7 +129,7 @@ def _convert(tp: Any, value: Any, meta: dict, ctx: Context, path: str) -> Any:
                 errors.append(exc.what)
         ctx.fail(path, errors[-1])
     if origin is Literal:
-        if value not in args:
+        if value not in args or (isinstance(value, bool) and not any(isinstance(a, bool) for a in args)):
             allowed = ", ".join(repr(a) for a in args)
             ctx.fail(path, f"must be one of {allowed}, got {_type_name(value)}")
         return value

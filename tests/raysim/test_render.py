@@ -122,8 +122,10 @@ def test_a_failing_run_leaves_nothing_behind(write_scenario, tmp_path, monkeypat
         raise RuntimeError("sensor crashed")
 
     monkeypatch.setitem(render_module.SENSOR_RENDERERS, "lidar", broken)
+    data = copy.deepcopy(BASE)
+    data["sensors"]["lidar"]["enabled"] = True
     with pytest.raises(RuntimeError):
-        render_module.render(load_scenario(write_scenario(BASE)), tmp_path / "rec", progress=False)
+        render_module.render(load_scenario(write_scenario(data)), tmp_path / "rec", progress=False)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["scenario.yaml"]
 
 

@@ -1,0 +1,69 @@
+"""The sea surface seen by the sensors: whitecap (foam) coverage and its moving patches.
+
+Calm water is a specular mirror at 905 nm (Fresnel reflectance about 2 %): a
+mast-mounted LiDAR at grazing angles gets nothing back from it. Foam on breaking
+crests is a diffuse reflector and does return points (REFERENCE.md section 2,
+VRX issues 29/135). raysim models the fraction of the sea covered by whitecaps
+from the wind with Monahan & O'Muircheartaigh (1980),
+``W = 3.84e-6 U10^3.41`` (U10 in m/s, W a fraction), using the larger of the
+configured wind and the wind typical of the configured Douglas sea state, and
+lays the foam out as patches: a smooth random field of plane waves travelling at
+deep-water phase speed ``sqrt(g / k)``, thresholded so that the covered fraction
+is W. Patches are a few metres to tens of metres across and drift with the waves.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.special import ndtri
+
+#: Wind speed typical of each Douglas sea state 0..6, m/s (Beaufort-Douglas correspondence,
+#: mid-band values; unverified engineering table).
+SEA_STATE_WIND_MPS = (0.0, 2.0, 4.5, 7.0, 9.5, 12.5, 16.0)
+GRAVITY_MPS2 = 9.81
+N_WAVES = 12
+#: Wavelengths of the foam pattern, m (patch sizes; unverified).
+FOAM_WAVELENGTH_RANGE_M = (4.0, 40.0)
+
+
+def whitecap_fraction(wind_speed_mps: float) -> float:
+    """Monahan & O'Muircheartaigh (1980): fraction of the sea covered by whitecaps."""
+    return float(min(1.0, 3.84e-6 * max(wind_speed_mps, 0.0) ** 3.41))
+
+
+class FoamField:
+    """Where the sea carries foam, for any points and times.
+
+    Parameters
+    ----------
+    wind_speed_mps : float
+        Configured wind speed.
+    sea_state : int
+        Douglas sea state 0..6.
+    wind_from_deg : float
+        Compass direction the wind blows from: the patches travel downwind.
+    rng : numpy.random.Generator
+        The world's ``sea.foam`` stream (wave directions, lengths and phases).
+    """
+
+    def __init__(self, wind_speed_mps: float, sea_state: int, wind_from_deg: float, rng: np.random.Generator):
+        self.effective_wind_mps = max(float(wind_speed_mps), SEA_STATE_WIND_MPS[int(sea_state)])
+        self.coverage = whitecap_fraction(self.effective_wind_mps)
+        downwind = np.radians(90.0 - (wind_from_deg + 180.0))  # ENU angle the waves travel to
+        spread = rng.uniform(-np.pi / 3, np.pi / 3, N_WAVES)
+        wavelength = np.exp(rng.uniform(*np.log(FOAM_WAVELENGTH_RANGE_M), N_WAVES))
+        k = 2 * np.pi / wavelength
+        self.kx = k * np.cos(downwind + spread)
+        self.ky = k * np.sin(downwind + spread)
+        self.omega = np.sqrt(GRAVITY_MPS2 * k)
+        self.phase = rng.uniform(0.0, 2 * np.pi, N_WAVES)
+        # sum of N cosines with random phases / sqrt(N/2) is close to standard normal
+        self.threshold = float(ndtri(1.0 - self.coverage)) if 0.0 < self.coverage < 1.0 else (np.inf if self.coverage <= 0 else -np.inf)
+
+    def is_foam(self, x_m: np.ndarray, y_m: np.ndarray, t_s: np.ndarray) -> np.ndarray:
+        """(N,) bool: whether the sea at (x, y) carries foam at time t."""
+        if self.coverage <= 0.0 or x_m.shape[0] == 0:
+            return np.zeros(np.shape(x_m), dtype=bool)
+        arg = np.multiply.outer(x_m, self.kx) + np.multiply.outer(y_m, self.ky) - np.multiply.outer(t_s, self.omega) + self.phase
+        field = np.cos(arg).sum(axis=1) / np.sqrt(N_WAVES / 2.0)
+        return field > self.threshold
