@@ -116,13 +116,18 @@ class LidarRenderer:
         """
         t_edges = np.append(cycle_time_s, cycle_time_s[-1] + hdl32e.CYCLE_DT_S)
         poses = self.world.own_ship.motion.poses(t_edges)
-        rot = poses.rotation() @ self.mount_rotation  # sensor -> world
+        rot = poses.rotation() @ self.mount_rotation  # sensor -> world, (C + 1, 3, 3)
         pos = poses.position_m + np.einsum("nij,j->ni", poses.rotation(), self.mount_translation)
-        frac = (np.arange(hdl32e.N_LASERS) * hdl32e.FIRING_DT_S / hdl32e.CYCLE_DT_S)[None, :, None, None]
-        rot_f = rot[:-1, None] + (rot[1:] - rot[:-1])[:, None] * frac  # (C, 32, 3, 3)
-        pos_f = pos[:-1, None] + (pos[1:] - pos[:-1])[:, None] * frac[..., 0]  # (C, 32, 3)
-        o_world = np.einsum("cjab,cjkb->cjka", rot_f, origins_s) + pos_f[:, :, None, :]
-        d_world = np.einsum("cjab,cjkb->cjka", rot_f, directions_s)
+        c, _, k, _ = directions_s.shape
+        frac = np.repeat(np.arange(hdl32e.N_LASERS) * (hdl32e.FIRING_DT_S / hdl32e.CYCLE_DT_S), k)  # (32 K,)
+        r0, dr = rot[:-1], rot[1:] - rot[:-1]
+        d = directions_s.reshape(c, hdl32e.N_LASERS * k, 3).transpose(0, 2, 1)  # (C, 3, 32 K)
+        d_world = r0 @ d + (dr @ d) * frac
+        # beam origins are (0, 0, z_offset): only the third column of the rotation matters
+        z = np.repeat(origins_s[0, :, 0, 2], k)
+        o_world = (r0[:, :, 2:3] + dr[:, :, 2:3] * frac) * z + pos[:-1, :, None] + (pos[1:] - pos[:-1])[:, :, None] * frac
+        o_world = o_world.transpose(0, 2, 1).reshape(c, hdl32e.N_LASERS, k, 3)
+        d_world = d_world.transpose(0, 2, 1).reshape(c, hdl32e.N_LASERS, k, 3)
         t_firing = cycle_time_s[:, None] + np.arange(hdl32e.N_LASERS)[None, :] * hdl32e.FIRING_DT_S
         return o_world, d_world, t_firing
 
@@ -146,11 +151,15 @@ class LidarRenderer:
         source = np.full(n, SOURCE_OBJECT, dtype=np.uint8)
         sea = obj == SEA_ID
         if sea.any():
-            idx = np.nonzero(sea)[0]
-            p = o_w.reshape(n, 3)[idx] + rng_m[idx, None] * d_w.reshape(n, 3)[idx]
-            foam = self.foam.is_foam(p[:, 0], p[:, 1], times[idx])
-            reflectance[idx] = np.where(foam, FOAM_REFLECTANCE, 0.0)  # calm water: specular, nothing back
-            source[idx] = SOURCE_SEA
+            reflectance[sea] = 0.0  # calm water: a specular mirror, nothing comes back
+            source[sea] = SOURCE_SEA
+            # foam is looked up only where a foam echo could be detected at all
+            could = sea & (phys.echo_power(FOAM_REFLECTANCE * cos_inc, rng_m, self.alpha) / k >= self.threshold / k)
+            idx = np.nonzero(could)[0]
+            if idx.size:
+                p = o_w.reshape(n, 3)[idx] + rng_m[idx, None] * d_w.reshape(n, 3)[idx]
+                foam = self.foam.is_foam(p[:, 0], p[:, 1], times[idx])
+                reflectance[idx[foam]] = FOAM_REFLECTANCE
         rng_m = np.where(obj == NO_HIT, np.inf, rng_m)
         power = phys.echo_power(reflectance * cos_inc, rng_m, self.alpha) / k
         power = np.where(np.isfinite(rng_m), power, 0.0)
