@@ -21,7 +21,7 @@ from scipy.special import ndtri
 #: mid-band values; unverified engineering table).
 SEA_STATE_WIND_MPS = (0.0, 2.0, 4.5, 7.0, 9.5, 12.5, 16.0)
 GRAVITY_MPS2 = 9.81
-N_WAVES = 12
+N_WAVES = 8
 #: Wavelengths of the foam pattern, m (patch sizes; unverified).
 FOAM_WAVELENGTH_RANGE_M = (4.0, 40.0)
 
@@ -64,6 +64,7 @@ class FoamField:
         """(N,) bool: whether the sea at (x, y) carries foam at time t."""
         if self.coverage <= 0.0 or x_m.shape[0] == 0:
             return np.zeros(np.shape(x_m), dtype=bool)
-        arg = np.multiply.outer(x_m, self.kx) + np.multiply.outer(y_m, self.ky) - np.multiply.outer(t_s, self.omega) + self.phase
-        field = np.cos(arg).sum(axis=1) / np.sqrt(N_WAVES / 2.0)
+        points = np.stack([x_m, y_m, t_s, np.ones_like(x_m)], axis=1)
+        waves = np.stack([self.kx, self.ky, -self.omega, self.phase])  # (4, N_WAVES)
+        field = np.cos(points @ waves).sum(axis=1) / np.sqrt(N_WAVES / 2.0)
         return field > self.threshold

@@ -93,6 +93,12 @@ def decoder_azimuths_centideg(block_az: np.ndarray, dual: bool = False) -> np.nd
     return (rounded % 36000).astype(np.uint16)
 
 
+_COS_AZ = np.cos(np.radians(np.arange(36000) * 0.01))
+_SIN_AZ = np.sin(np.radians(np.arange(36000) * 0.01))
+_COS_EL = np.cos(np.radians(ELEVATION_DEG))
+_SIN_EL = np.sin(np.radians(ELEVATION_DEG))
+
+
 def beam_directions(azimuth_centideg: np.ndarray) -> np.ndarray:
     """Unit beam directions in the sensor frame for firing slots.
 
@@ -104,15 +110,12 @@ def beam_directions(azimuth_centideg: np.ndarray) -> np.ndarray:
     Returns
     -------
     (..., 32, 3) float64
-        ``(cos w cos a, -cos w sin a, sin w)``.
+        ``(cos w cos a, -cos w sin a, sin w)`` (cosines from a table of the 36000 encoder steps).
     """
-    a = np.radians(azimuth_centideg.astype(np.float64) * 0.01)
-    w = np.radians(ELEVATION_DEG)
-    cw = np.cos(w)
     out = np.empty(azimuth_centideg.shape + (3,))
-    out[..., 0] = cw * np.cos(a)
-    out[..., 1] = -cw * np.sin(a)
-    out[..., 2] = np.broadcast_to(np.sin(w), azimuth_centideg.shape)
+    out[..., 0] = _COS_EL * _COS_AZ[azimuth_centideg]
+    out[..., 1] = -_COS_EL * _SIN_AZ[azimuth_centideg]
+    out[..., 2] = _SIN_EL
     return out
 
 

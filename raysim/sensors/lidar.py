@@ -137,76 +137,79 @@ class LidarRenderer:
         """Cast and measure C firing cycles."""
         c = cycle_time_s.shape[0]
         k = self.offsets.shape[0]
+        f = c * hdl32e.N_LASERS
+        n = f * k
         origins_s, directions_s = self._sensor_rays(firing_azimuth)
         o_w, d_w, t_firing = self._world_rays(cycle_time_s, origins_s, directions_s)
-        n = c * hdl32e.N_LASERS * k
-        times = np.repeat(t_firing.reshape(-1), k)
-        hits = self.scene.cast(o_w.reshape(n, 3), d_w.reshape(n, 3), times, max_range_m=self.cfg.range_max_m + 1.0)
-        rng_m = hits.range_m
-        obj = hits.object_id
-        cos_inc = np.abs(np.einsum("ij,ij->i", hits.normal.astype(np.float64), d_w.reshape(n, 3)))
-        mat = np.where(hits.material >= 0, hits.material, 0)
-        reflectance = self.materials["reflectance_905nm"][mat].astype(np.float64)
-        retro = self.materials["retroreflective"][mat] & (obj != NO_HIT)
-        source = np.full(n, SOURCE_OBJECT, dtype=np.uint8)
-        sea = obj == SEA_ID
+        o_w, d_w = o_w.reshape(n, 3), d_w.reshape(n, 3)
+        times = np.repeat(t_firing.reshape(-1), k) if k > 1 else t_firing.reshape(-1)
+        hits = self.scene.cast(o_w, d_w, times, max_range_m=self.cfg.range_max_m + 1.0)
+
+        # physics on the rays that hit something (the sky is a large part of a sweep)
+        h = np.nonzero(hits.object_id != NO_HIT)[0]
+        r_h = hits.range_m[h]
+        obj_h = hits.object_id[h]
+        cos_h = np.abs(np.einsum("ij,ij->i", hits.normal[h], d_w[h]))
+        mat_h = hits.material[h]
+        reflectance = self.materials["reflectance_905nm"][mat_h].astype(np.float64)
+        retro = self.materials["retroreflective"][mat_h]
+        source = np.zeros(h.size, dtype=np.uint8)
+        sea = obj_h == SEA_ID
         if sea.any():
             reflectance[sea] = 0.0  # calm water: a specular mirror, nothing comes back
             source[sea] = SOURCE_SEA
             # foam is looked up only where a foam echo could be detected at all
-            could = sea & (phys.echo_power(FOAM_REFLECTANCE * cos_inc, rng_m, self.alpha) / k >= self.threshold / k)
-            idx = np.nonzero(could)[0]
-            if idx.size:
-                p = o_w.reshape(n, 3)[idx] + rng_m[idx, None] * d_w.reshape(n, 3)[idx]
-                foam = self.foam.is_foam(p[:, 0], p[:, 1], times[idx])
-                reflectance[idx[foam]] = FOAM_REFLECTANCE
-        rng_m = np.where(obj == NO_HIT, np.inf, rng_m)
-        power = phys.echo_power(reflectance * cos_inc, rng_m, self.alpha) / k
-        power = np.where(np.isfinite(rng_m), power, 0.0)
-        byte = phys.reflectivity_byte(reflectance, cos_inc, retro)
-        ids = np.where(sea | (obj == NO_HIT), -1, obj).astype(np.int32)
-
-        # candidate echoes per firing: K sub-rays plus, in weather, one false echo near the sensor
-        f = c * hdl32e.N_LASERS
-        cand_r = rng_m.reshape(f, k)
-        cand_p = power.reshape(f, k)
-        cand_b = byte.reshape(f, k)
-        cand_id = ids.reshape(f, k)
-        cand_src = source.reshape(f, k)
+            could = np.nonzero(sea & (phys.echo_power(FOAM_REFLECTANCE * cos_h, r_h, self.alpha) >= self.threshold))[0]
+            if could.size:
+                p = o_w[h[could]] + r_h[could, None] * d_w[h[could]]
+                foam = self.foam.is_foam(p[:, 0], p[:, 1], times[h[could]])
+                reflectance[could[foam]] = FOAM_REFLECTANCE
+        power_h = phys.echo_power(reflectance * cos_h, r_h, self.alpha) / k
+        e = k + (1 if self.alpha > 0 else 0)  # candidates per firing: sub-rays and a weather echo
+        cand_r = np.full((f, e), np.inf)
+        cand_p = np.zeros((f, e))
+        cand_b = np.zeros((f, e), dtype=np.uint8)
+        cand_id = np.full((f, e), -1, dtype=np.int32)
+        cand_src = np.zeros((f, e), dtype=np.uint8)
+        row, col = h // k, h % k
+        cand_r[row, col] = r_h
+        cand_p[row, col] = power_h
+        cand_b[row, col] = phys.reflectivity_byte(reflectance, cos_h, retro)
+        cand_id[row, col] = np.where(sea, -1, obj_h)
+        cand_src[row, col] = source
         if self.alpha > 0:
             p_false = 1.0 - np.exp(-self.alpha * phys.FALSE_ECHO_WINDOW_M)
             has = self.weather_rng.random(f) < p_false
             r_false = self.cfg.range_min_m + self.weather_rng.exponential(phys.FALSE_ECHO_MEAN_RANGE_M, f)
-            r_false = np.where(has & (r_false < phys.FALSE_ECHO_WINDOW_M), r_false, np.inf)
-            p_fe = np.where(np.isfinite(r_false), phys.echo_power(np.full(f, phys.FALSE_ECHO_REFLECTANCE), r_false, self.alpha), 0.0)
-            b_fe = np.clip(np.round(100 * phys.FALSE_ECHO_REFLECTANCE * np.ones(f)), 1, 100).astype(np.uint8)
-            cand_r = np.concatenate([cand_r, r_false[:, None]], axis=1)
-            cand_p = np.concatenate([cand_p, p_fe[:, None]], axis=1)
-            cand_b = np.concatenate([cand_b, b_fe[:, None]], axis=1)
-            cand_id = np.concatenate([cand_id, np.full((f, 1), -1, np.int32)], axis=1)
-            cand_src = np.concatenate([cand_src, np.full((f, 1), SOURCE_WEATHER, np.uint8)], axis=1)
+            has &= r_false < phys.FALSE_ECHO_WINDOW_M
+            cand_r[has, k] = r_false[has]
+            cand_p[has, k] = phys.echo_power(np.full(has.sum(), phys.FALSE_ECHO_REFLECTANCE), r_false[has], self.alpha)
+            cand_b[has, k] = round(100 * phys.FALSE_ECHO_REFLECTANCE)
+            cand_src[has, k] = SOURCE_WEATHER
         strongest, last, group_r, group_id = phys.select_echoes(cand_r, cand_p, self.threshold)
         picks = [last, strongest] if self.dual else [last if self.cfg.return_mode == "last" else strongest]
-        rows = np.arange(f)
         n_ret = len(picks)
-        noise = self.noise_rng.normal(0.0, self.cfg.range_noise_m, size=(n_ret, f)) if self.cfg.range_noise_m > 0 else np.zeros((n_ret, f))
         units = np.zeros((n_ret, f), dtype=np.uint16)
         refl = np.zeros((n_ret, f), dtype=np.uint8)
         oid = np.full((n_ret, f), -1, dtype=np.int32)
         src = np.zeros((n_ret, f), dtype=np.uint8)
         for i, pick in enumerate(picks):
-            valid = pick >= 0
-            col = np.where(valid, pick, 0)
-            measured = group_r[rows, col] + noise[i]
+            rows = np.nonzero(pick >= 0)[0]
+            cols = pick[rows]
+            measured = group_r[rows, cols]
+            if self.cfg.range_noise_m > 0:
+                measured = measured + self.noise_rng.normal(0.0, self.cfg.range_noise_m, rows.size)
             q = np.round(measured / hdl32e.DISTANCE_UNIT_M)
-            ok = valid & np.isfinite(measured) & (measured >= self.cfg.range_min_m) & (measured <= self.cfg.range_max_m) & (q >= 1) & (q <= 65535)
-            units[i] = np.where(ok, q, 0).astype(np.uint16)
-            refl[i] = np.where(ok, cand_b[rows, col], 0)
-            oid[i] = np.where(ok, cand_id[rows, col], -1)
-            src[i] = np.where(ok, cand_src[rows, col], 0)
+            ok = (measured >= self.cfg.range_min_m) & (measured <= self.cfg.range_max_m) & (q >= 1) & (q <= 65535)
+            rows, cols = rows[ok], cols[ok]
+            units[i, rows] = q[ok]
+            refl[i, rows] = cand_b[rows, cols]
+            oid[i, rows] = cand_id[rows, cols]
+            src[i, rows] = cand_src[rows, cols]
         if self.dual:  # one echo group: both blocks carry the same measurement
+            rows = np.arange(f)
             same = (group_id[rows, np.maximum(picks[0], 0)] == group_id[rows, np.maximum(picks[1], 0)]) & (units[0] > 0)
-            units[1] = np.where(same, units[0], units[1])  # one echo: both blocks carry it
+            units[1] = np.where(same, units[0], units[1])
             refl[1] = np.where(same, refl[0], refl[1])
             oid[1] = np.where(same, oid[0], oid[1])
             src[1] = np.where(same, src[0], src[1])

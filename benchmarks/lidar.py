@@ -1,0 +1,134 @@
+"""LiDAR rendering speed on scenarios/busy_open_sea.yaml, against raw Embree in the same run.
+
+Usage::
+
+    python benchmarks/lidar.py [--quick] [--out benchmarks/results/lidar.md]
+
+- Multiple of real time, *marginal*: the whole ``raysim render --sensors lidar``
+  pipeline (PCAP and NPZ sweeps written) for two durations; the difference of their
+  wall times over the difference of the durations excludes start-up (loading,
+  meshes, acceleration structures).
+- Fraction of raw Embree: the world rays of one revolution (the same rays the
+  renderer casts) against one static Open3D ``RaycastingScene`` of every object at
+  its pose at that instant, one ``cast_rays`` on a prebuilt tensor; the renderer's
+  rays per second of wall time divided by that.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime as dt
+import os
+import platform
+import statistics
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+import open3d as o3d  # noqa: E402
+
+from raysim import render as render_module  # noqa: E402
+from raysim.scenario import load_scenario, with_overrides  # noqa: E402
+from raysim.sensors import hdl32e  # noqa: E402
+from raysim.sensors.lidar import LidarRenderer  # noqa: E402
+from raysim.world import World  # noqa: E402
+
+
+def timed_render(scenario, duration_s: float) -> tuple[float, dict]:
+    """Wall time of a full LiDAR render of ``duration_s`` into a temporary directory."""
+    s = with_overrides(scenario, duration_s=duration_s, sensors=("lidar",))
+    with tempfile.TemporaryDirectory() as tmp:
+        start = time.perf_counter()
+        result = render_module.render(s, Path(tmp) / "rec", progress=False)
+        return time.perf_counter() - start, result.manifest
+
+
+def raw_embree_rays_per_s(scenario, t_s: float, repeats: int) -> tuple[float, int]:
+    """Raw Open3D casting of one revolution's world rays against the frozen scene at t_s."""
+    world = World(scenario)
+    lidar = LidarRenderer(world, scene=None)
+    n = int(round(hdl32e.cycles_per_revolution(lidar.cfg.rotation_hz)))
+    k0 = int(t_s / hdl32e.CYCLE_DT_S)
+    t = (k0 + np.arange(n)) * hdl32e.CYCLE_DT_S
+    block = hdl32e.block_azimuth_centideg(t, lidar.cfg.rotation_hz)
+    az = hdl32e.decoder_azimuths_centideg(block[: n // 12 * 12].reshape(-1, 12)).reshape(-1, 32)
+    t = t[: az.shape[0]]
+    origins, directions = lidar._sensor_rays(az)
+    o_w, d_w, _ = lidar._world_rays(t, origins, directions)
+    rays = np.concatenate([o_w.reshape(-1, 3), d_w.reshape(-1, 3)], axis=1).astype(np.float32)
+    scene = o3d.t.geometry.RaycastingScene()
+    for obj in world.objects:
+        poses = obj.motion.poses(np.array([t_s]))
+        vertices = obj.mesh.vertices_m @ poses.rotation()[0].T + poses.position_m[0]
+        scene.add_triangles(o3d.core.Tensor(vertices.astype(np.float32)), o3d.core.Tensor(obj.mesh.faces.astype(np.uint32)))
+    tensor = o3d.core.Tensor(rays)
+    scene.cast_rays(tensor)
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        scene.cast_rays(tensor)
+        times.append(time.perf_counter() - start)
+    return rays.shape[0] / statistics.median(times), rays.shape[0]
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--quick", action="store_true")
+    parser.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results" / "lidar.md")
+    args = parser.parse_args(argv)
+    scenario = load_scenario(ROOT / "scenarios" / "busy_open_sea.yaml")
+    short, long = (1.0, 3.0) if args.quick else (2.0, 12.0)
+    reps = 1 if args.quick else 3
+    walls_short, walls_long, manifest = [], [], None
+    for _ in range(reps):
+        walls_short.append(timed_render(scenario, short)[0])
+        w, manifest = timed_render(scenario, long)
+        walls_long.append(w)
+    marginal = (statistics.median(walls_long) - statistics.median(walls_short)) / (long - short)
+    startup = statistics.median(walls_short) - marginal * short
+    sim_rays_per_s = 1.0 / hdl32e.CYCLE_DT_S * 32 * scenario.sensors.lidar.sub_rays
+    raw, n_rays = raw_embree_rays_per_s(scenario, 60.0, 5 if not args.quick else 2)
+    points = manifest["counts"]["lidar/points"] / long
+    lidar_rays_per_s = sim_rays_per_s / marginal
+    rows = [
+        ("simulated firings per second of scenario", f"{sim_rays_per_s:,.0f}"),
+        ("points per second of scenario (busy_open_sea)", f"{points:,.0f}"),
+        ("start-up, s (world, meshes, acceleration structures)", f"{startup:.2f}"),
+        ("wall time per second of scenario, s (marginal)", f"{marginal:.3f}"),
+        ("**multiple of real time (marginal)**", f"**{1.0 / marginal:.2f}**"),
+        ("renderer rays/s (marginal)", f"{lidar_rays_per_s / 1e6:.2f} M"),
+        (f"raw Embree rays/s (Open3D cast_rays, same {n_rays:,} rays, frozen scene)", f"{raw / 1e6:.2f} M"),
+        ("**fraction of raw Embree**", f"**{lidar_rays_per_s / raw:.2f}**"),
+    ]
+    cpu = next((line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo") if line.startswith("model name")), "?")
+    text = "\n".join([
+        "# LiDAR rendering benchmark",
+        "",
+        f"Generated by `python benchmarks/lidar.py{' --quick' if args.quick else ''}` on "
+        f"{dt.datetime.now(dt.timezone.utc):%Y-%m-%d %H:%M} UTC; {os.cpu_count()} cores, {cpu}; "
+        f"Python {platform.python_version()}, numpy {np.__version__}, Open3D {o3d.__version__}.",
+        "",
+        f"Scenario `scenarios/busy_open_sea.yaml`, HDL-32E at {scenario.sensors.lidar.rotation_hz:g} Hz, "
+        f"{scenario.sensors.lidar.return_mode} return, {scenario.sensors.lidar.sub_rays} ray(s) per beam; every output "
+        f"written (PCAP with position packets, NPZ sweeps, truth, navigation). Wall times are medians of {reps} runs of "
+        f"{short:g} s and {long:g} s of scenario.",
+        "",
+        "| figure | value |",
+        "|---|---:|",
+        *[f"| {a} | {b} |" for a, b in rows],
+        "",
+    ])
+    print(text)
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    args.out.write_text(text, encoding="utf-8")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
