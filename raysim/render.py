@@ -41,12 +41,13 @@ class RenderContext:
     _scene: object = None
 
     def scene(self):
-        """The ray engine over the world (built once, shared by the sensors)."""
+        """The ray engine for the own ship's sensors (built once, shared by them)."""
         if self._scene is None:
             from raysim.materials import material_index
-            from raysim.scene import Scene
+            from raysim.sensors.carrier import CarrierScene
 
-            self._scene = Scene(self.world.scene_objects(), sea=True, sea_material=material_index("sea"))
+            self._scene = CarrierScene(self.world.scene_objects(), carrier_id=self.world.own_ship.object_id,
+                                       sea_material=material_index("sea"))
         return self._scene
 
 

@@ -64,7 +64,16 @@ class FoamField:
         """(N,) bool: whether the sea at (x, y) carries foam at time t."""
         if self.coverage <= 0.0 or x_m.shape[0] == 0:
             return np.zeros(np.shape(x_m), dtype=bool)
-        points = np.stack([x_m, y_m, t_s, np.ones_like(x_m)], axis=1)
-        waves = np.stack([self.kx, self.ky, -self.omega, self.phase])  # (4, N_WAVES)
-        field = np.cos(points @ waves).sum(axis=1) / np.sqrt(N_WAVES / 2.0)
+        # float32 about a reference point and time (folded into the phases in float64) keeps the
+        # phase error below 1e-4 rad while halving the cost of the cosines
+        x0, y0, t0 = float(x_m[0]), float(y_m[0]), float(t_s[0])
+        phase = np.mod(self.phase + self.kx * x0 + self.ky * y0 - self.omega * t0, 2 * np.pi).astype(np.float32)
+        local = np.empty((x_m.shape[0], 3), dtype=np.float32)
+        local[:, 0] = x_m - x0
+        local[:, 1] = y_m - y0
+        local[:, 2] = t_s - t0
+        waves = np.stack([self.kx, self.ky, -self.omega]).astype(np.float32)  # (3, N_WAVES)
+        arg = local @ waves
+        arg += phase
+        field = np.cos(arg, out=arg).sum(axis=1) / np.float32(np.sqrt(N_WAVES / 2.0))
         return field > self.threshold

@@ -26,9 +26,10 @@ from raysim.recording import nmea
 from raysim.recording.npz import write_npz
 from raysim.recording.staging import atomic_path
 from raysim.recording.velodyne import PcapWriter, encode_data_packets, encode_position_packet
-from raysim.scene import NO_HIT, SEA_ID, Scene
+from raysim.scene import NO_HIT, SEA_ID, Hits
 from raysim.sea import FoamField
 from raysim.sensors import hdl32e, lidar_physics as phys
+from raysim.sensors.carrier import CarrierScene
 
 SOURCE_OBJECT, SOURCE_SEA, SOURCE_WEATHER = 0, 1, 2
 FOAM_REFLECTANCE = 0.25  # whitecap foam at 905 nm, diffuse (unverified; bright in the visible, darker in NIR)
@@ -64,11 +65,11 @@ class LidarRenderer:
     Parameters
     ----------
     world : raysim.world.World
-    scene : raysim.scene.Scene
-        The ray engine over the world's objects (sea included).
+    scene : raysim.sensors.carrier.CarrierScene
+        The ray engine over the world's objects (sea included), own ship cast in its body frame.
     """
 
-    def __init__(self, world, scene: Scene):
+    def __init__(self, world, scene: CarrierScene):
         self.world = world
         self.scene = scene
         s = world.scenario
@@ -85,11 +86,51 @@ class LidarRenderer:
         self.materials = material_table()
         self.sea_material = material_index("sea")
         self.offsets = phys.sub_ray_offsets(self.cfg.sub_rays, self.cfg.beam_divergence_mrad * 1e-3)
+        self.own_table = self._own_ship_table() if self.offsets.shape[0] == 1 else None
         self.start_unix_s = s.start_time.timestamp()
         self.n_cycles = int(np.floor(s.duration_s / hdl32e.CYCLE_DT_S + 1e-9))
         self.n_packets = self.n_cycles // self.cycles_per_packet
 
     # ------------------------------------------------------------------ geometry
+
+    def _own_ship_table(self):
+        """Own-ship hits of every beam the sensor can fire: 36000 encoder steps x 32 lasers.
+
+        The own ship is rigid and the mount fixed, so in the body frame these rays never
+        change: they are cast once here and looked up for every firing. Kept compact:
+        a float32 range and a triangle index per beam (-1 = misses the own ship); normals
+        and materials come from the triangle.
+        """
+        if self.scene is None or self.scene.carrier is None:
+            return None
+        az = np.broadcast_to(np.arange(36000, dtype=np.uint16)[:, None], (36000, hdl32e.N_LASERS))
+        origins, directions = self._sensor_rays(az)
+        n = origins.shape[0] * hdl32e.N_LASERS
+        o_b = origins.reshape(n, 3) @ self.mount_rotation.T + self.mount_translation
+        d_b = directions.reshape(n, 3) @ self.mount_rotation.T
+        hits = self.scene.carrier_hits(o_b, d_b, max_range_m=self.cfg.range_max_m + 1.0)
+        own = self.world.own_ship.mesh
+        v = own.vertices_m[own.faces]
+        normals = np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0])
+        normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-12)
+        return {
+            "range_m": hits.range_m.astype(np.float32),
+            "primitive": np.where(hits.object_id != NO_HIT, hits.primitive, -1).astype(np.int32),
+            "normal": np.vstack([normals, np.zeros((1, 3))]).astype(np.float32),  # index -1 -> zeros
+            "material": np.append(own.face_material, -1).astype(np.int16),
+            "object_id": self.world.own_ship.object_id,
+        }
+
+    def _own_hits(self, firing_azimuth: np.ndarray):
+        """Own-ship hits of the chunk's beams from the table (body-frame normals)."""
+        t = self.own_table
+        c = firing_azimuth.shape[0]
+        key = firing_azimuth.reshape(-1).astype(np.int64) * hdl32e.N_LASERS + np.tile(np.arange(hdl32e.N_LASERS), c)
+        prim = t["primitive"][key]
+        hit = prim >= 0
+        rng = np.where(hit, t["range_m"][key], np.inf)
+        return Hits(rng.astype(np.float64), np.where(hit, t["object_id"], NO_HIT).astype(np.int32),
+                    t["normal"][prim], t["material"][prim], prim)
 
     def _sensor_rays(self, firing_azimuth: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Sensor-frame beam origins and directions, (C, 32, K, 3) each (K sub-rays)."""
@@ -142,14 +183,24 @@ class LidarRenderer:
         origins_s, directions_s = self._sensor_rays(firing_azimuth)
         o_w, d_w, t_firing = self._world_rays(cycle_time_s, origins_s, directions_s)
         o_w, d_w = o_w.reshape(n, 3), d_w.reshape(n, 3)
+        # the same rays in the own-ship body frame (the mount is fixed): the own ship is cast there
+        d_b = directions_s.reshape(n, 3) @ self.mount_rotation.T
         times = np.repeat(t_firing.reshape(-1), k) if k > 1 else t_firing.reshape(-1)
-        hits = self.scene.cast(o_w, d_w, times, max_range_m=self.cfg.range_max_m + 1.0)
+        if self.own_table is not None:
+            own = self._own_hits(firing_azimuth)
+            hits, on_carrier = self.scene.cast(o_w, d_w, times, max_range_m=self.cfg.range_max_m + 1.0, carrier_hits=own)
+        else:
+            o_b = origins_s.reshape(n, 3) @ self.mount_rotation.T + self.mount_translation
+            hits, on_carrier = self.scene.cast(o_w, d_w, times, o_b, d_b, max_range_m=self.cfg.range_max_m + 1.0)
 
         # physics on the rays that hit something (the sky is a large part of a sweep)
         h = np.nonzero(hits.object_id != NO_HIT)[0]
         r_h = hits.range_m[h]
         obj_h = hits.object_id[h]
+        # incidence |n . d|: own-ship normals come in its body frame, with the body-frame direction
         cos_h = np.abs(np.einsum("ij,ij->i", hits.normal[h], d_w[h]))
+        own_h = np.flatnonzero(on_carrier[h])
+        cos_h[own_h] = np.abs(np.einsum("ij,ij->i", hits.normal[h[own_h]], d_b[h[own_h]]))
         mat_h = hits.material[h]
         reflectance = self.materials["reflectance_905nm"][mat_h].astype(np.float64)
         retro = self.materials["retroreflective"][mat_h]

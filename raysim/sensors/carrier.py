@@ -1,0 +1,104 @@
+"""The world as seen from a sensor on the own ship.
+
+A sensor's rays start on the own ship, so the own ship's bounding sphere holds every
+ray origin: cast against it like any moving object, every ray would pay for a pose
+evaluation and a transformation. The sensor already knows its rays in the own-ship
+body frame (the mount is fixed), so :class:`CarrierScene` casts the own ship there,
+without any pose, and the rest of the world in world coordinates.
+
+Rays stopped by the own ship (a mast-top LiDAR sees a lot of its own deck) are not
+cast into the world at all: nothing else can lie between a sensor and its own
+deck, except the sea where a ray meets the hull below the waterline, which is
+checked analytically.
+
+A sensor whose body-frame rays repeat (the LiDAR's beams depend only on the
+encoder azimuth and the laser) can precompute the own-ship hits once:
+:meth:`CarrierScene.carrier_hits` on all of them, then pass the looked-up
+:class:`raysim.scene.Hits` to :meth:`CarrierScene.cast`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from raysim.motion import Stationary
+from raysim.scene import NO_HIT, SEA_ID, Hits, Scene, SceneObject, intersect_sea
+
+
+class CarrierScene:
+    """Ray engine for sensors carried by the own ship (truth id ``carrier_id``).
+
+    Parameters
+    ----------
+    objects : sequence of SceneObject
+        Every object of the world, the own ship included.
+    carrier_id : int
+        Truth id of the own ship (0).
+    sea_material : int
+        Material index of sea hits.
+
+    Notes
+    -----
+    Normals of own-ship hits are in the own-ship *body* frame (use them with the
+    body-frame directions); all other normals are in the world frame.
+    """
+
+    def __init__(self, objects, carrier_id: int = 0, sea_material: int = -1):
+        carrier = [o for o in objects if o.object_id == carrier_id]
+        self.sea_material = sea_material
+        self.world = Scene([o for o in objects if o.object_id != carrier_id], sea=True, sea_material=sea_material)
+        self.carrier = None
+        if carrier:
+            body = carrier[0]
+            self.carrier = Scene([SceneObject(body.object_id, body.vertices_m, body.faces, body.face_material,
+                                              Stationary([0.0, 0.0, 0.0]))], sea=False)
+
+    def carrier_hits(self, origins_body_m: np.ndarray, directions_body: np.ndarray, max_range_m=np.inf) -> Hits:
+        """Hits of body-frame rays on the own ship alone (body-frame normals)."""
+        n = origins_body_m.shape[0]
+        if self.carrier is None:
+            return Hits.empty(n)
+        return self.carrier.cast(origins_body_m, directions_body, np.zeros(n), max_range_m=max_range_m)
+
+    def cast(self, origins_world_m, directions_world, times_s, origins_body_m=None, directions_body=None,
+             max_range_m=np.inf, carrier_hits: Hits | None = None) -> tuple[Hits, np.ndarray]:
+        """First hits of rays given in the world and in the own-ship body frame.
+
+        Parameters
+        ----------
+        origins_world_m, directions_world : (N, 3) float
+        times_s : (N,) float
+        origins_body_m, directions_body : (N, 3) float
+            The same rays in the own-ship body frame (needed unless ``carrier_hits`` is given).
+        max_range_m : float
+        carrier_hits : Hits, optional
+            Precomputed own-ship hits of these rays (:meth:`carrier_hits`).
+
+        Returns
+        -------
+        hits : Hits
+            Nearest hit per ray.
+        on_carrier : (N,) bool
+            Which rays hit the own ship first (their normals are body-frame).
+        """
+        own = carrier_hits if carrier_hits is not None else self.carrier_hits(origins_body_m, directions_body, max_range_m)
+        on_carrier = own.object_id != NO_HIT
+        if on_carrier.any():
+            # the sea can come first where a ray meets the hull below the waterline
+            idx = np.flatnonzero(on_carrier)
+            sea = intersect_sea(origins_world_m[idx, 2], directions_world[idx, 2])
+            wet = sea < own.range_m[idx]
+            on_carrier[idx[wet]] = False
+        free = np.flatnonzero(~on_carrier)
+        hits = Hits(own.range_m.copy(), own.object_id.copy(), own.normal.copy(), own.material.copy(), own.primitive.copy())
+        if free.size:
+            world = self.world.cast(origins_world_m[free], directions_world[free], times_s[free], max_range_m=max_range_m)
+            hits.range_m[free] = world.range_m
+            hits.object_id[free] = world.object_id
+            hits.normal[free] = world.normal
+            hits.material[free] = world.material
+            hits.primitive[free] = world.primitive
+        return hits, on_carrier
+
+
+__all__ = ["CarrierScene", "Hits", "SEA_ID"]
