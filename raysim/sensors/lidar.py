@@ -26,7 +26,7 @@ from raysim.recording import nmea
 from raysim.recording.npz import write_npz
 from raysim.recording.staging import atomic_path
 from raysim.recording.velodyne import PcapWriter, encode_data_packets, encode_position_packet
-from raysim.scene import NO_HIT, SEA_ID, Hits
+from raysim.scene import NO_HIT, SEA_ID, intersect_sea
 from raysim.sea import FoamField
 from raysim.sensors import hdl32e, lidar_physics as phys
 from raysim.sensors.carrier import CarrierScene
@@ -98,8 +98,9 @@ class LidarRenderer:
 
         The own ship is rigid and the mount fixed, so in the body frame these rays never
         change: they are cast once here and looked up for every firing. Kept compact:
-        a float32 range and a triangle index per beam (-1 = misses the own ship); normals
-        and materials come from the triangle.
+        per beam the range, the echo's relative power and reflectivity byte (all constant:
+        the incidence and material do not change), and whether the hit is low enough on
+        the hull for the sea to come first.
         """
         if self.scene is None or self.scene.carrier is None:
             return None
@@ -109,28 +110,20 @@ class LidarRenderer:
         o_b = origins.reshape(n, 3) @ self.mount_rotation.T + self.mount_translation
         d_b = directions.reshape(n, 3) @ self.mount_rotation.T
         hits = self.scene.carrier_hits(o_b, d_b, max_range_m=self.cfg.range_max_m + 1.0)
-        own = self.world.own_ship.mesh
-        v = own.vertices_m[own.faces]
-        normals = np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0])
-        normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-12)
+        hit = hits.object_id != NO_HIT
+        cos_inc = np.abs(np.einsum("ij,ij->i", hits.normal, d_b))
+        mat = np.where(hit, hits.material, 0)
+        reflectance = np.where(hit, self.materials["reflectance_905nm"][mat], 0.0)
+        rng = np.where(hit, hits.range_m, np.inf)
+        hit_z = o_b[:, 2] + np.where(hit, hits.range_m, 0.0) * d_b[:, 2]
         return {
-            "range_m": hits.range_m.astype(np.float32),
-            "primitive": np.where(hits.object_id != NO_HIT, hits.primitive, -1).astype(np.int32),
-            "normal": np.vstack([normals, np.zeros((1, 3))]).astype(np.float32),  # index -1 -> zeros
-            "material": np.append(own.face_material, -1).astype(np.int16),
+            "range_m": rng.astype(np.float32),
+            "power": np.where(hit, phys.echo_power(reflectance * cos_inc, rng, self.alpha), 0.0).astype(np.float32),
+            "byte": phys.reflectivity_byte(reflectance, cos_inc, self.materials["retroreflective"][mat] & hit),
+            # hits near or below the waterline: the sea may come first when the ship rolls or heaves
+            "wet": hit & (hit_z < 1.0),
             "object_id": self.world.own_ship.object_id,
         }
-
-    def _own_hits(self, firing_azimuth: np.ndarray):
-        """Own-ship hits of the chunk's beams from the table (body-frame normals)."""
-        t = self.own_table
-        c = firing_azimuth.shape[0]
-        key = firing_azimuth.reshape(-1).astype(np.int64) * hdl32e.N_LASERS + np.tile(np.arange(hdl32e.N_LASERS), c)
-        prim = t["primitive"][key]
-        hit = prim >= 0
-        rng = np.where(hit, t["range_m"][key], np.inf)
-        return Hits(rng.astype(np.float64), np.where(hit, t["object_id"], NO_HIT).astype(np.int32),
-                    t["normal"][prim], t["material"][prim], prim)
 
     def _sensor_rays(self, firing_azimuth: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Sensor-frame beam origins and directions, (C, 32, K, 3) each (K sub-rays)."""
@@ -183,25 +176,50 @@ class LidarRenderer:
         origins_s, directions_s = self._sensor_rays(firing_azimuth)
         o_w, d_w, t_firing = self._world_rays(cycle_time_s, origins_s, directions_s)
         o_w, d_w = o_w.reshape(n, 3), d_w.reshape(n, 3)
-        # the same rays in the own-ship body frame (the mount is fixed): the own ship is cast there
-        d_b = directions_s.reshape(n, 3) @ self.mount_rotation.T
         times = np.repeat(t_firing.reshape(-1), k) if k > 1 else t_firing.reshape(-1)
+        max_range = self.cfg.range_max_m + 1.0
+        # candidate echoes per firing: K sub-rays and, in weather, one false echo near the sensor
+        e = k + (1 if self.alpha > 0 else 0)
+        cand_r = np.full((f, e), np.inf)
+        cand_p = np.zeros((f, e))
+        cand_b = np.zeros((f, e), dtype=np.uint8)
+        cand_id = np.full((f, e), -1, dtype=np.int32)
+        cand_src = np.zeros((f, e), dtype=np.uint8)
         if self.own_table is not None:
-            own = self._own_hits(firing_azimuth)
-            hits, on_carrier = self.scene.cast(o_w, d_w, times, max_range_m=self.cfg.range_max_m + 1.0, carrier_hits=own)
+            # the own ship from the beam table; only the other rays go into the world
+            t = self.own_table
+            key = firing_azimuth.reshape(-1).astype(np.int64) * hdl32e.N_LASERS + np.tile(np.arange(hdl32e.N_LASERS), c)
+            r_own = t["range_m"][key].astype(np.float64)
+            on_own = np.isfinite(r_own)
+            wet = np.flatnonzero(t["wet"][key])
+            if wet.size:
+                on_own[wet] &= ~(intersect_sea(o_w[wet, 2], d_w[wet, 2]) < r_own[wet])
+            own = np.flatnonzero(on_own)
+            cand_r[own, 0] = r_own[own]
+            cand_p[own, 0] = t["power"][key[own]]
+            cand_b[own, 0] = t["byte"][key[own]]
+            cand_id[own, 0] = t["object_id"]
+            free = np.flatnonzero(~on_own)
+            hits = self.scene.world.cast(o_w[free], d_w[free], times[free], max_range_m=max_range)
+            own_body = None
         else:
             o_b = origins_s.reshape(n, 3) @ self.mount_rotation.T + self.mount_translation
-            hits, on_carrier = self.scene.cast(o_w, d_w, times, o_b, d_b, max_range_m=self.cfg.range_max_m + 1.0)
+            d_b = directions_s.reshape(n, 3) @ self.mount_rotation.T
+            hits, on_carrier = self.scene.cast(o_w, d_w, times, o_b, d_b, max_range_m=max_range)
+            free = np.arange(n)
+            own_body = (on_carrier, d_b)
 
-        # physics on the rays that hit something (the sky is a large part of a sweep)
-        h = np.nonzero(hits.object_id != NO_HIT)[0]
-        r_h = hits.range_m[h]
-        obj_h = hits.object_id[h]
-        # incidence |n . d|: own-ship normals come in its body frame, with the body-frame direction
-        cos_h = np.abs(np.einsum("ij,ij->i", hits.normal[h], d_w[h]))
-        own_h = np.flatnonzero(on_carrier[h])
-        cos_h[own_h] = np.abs(np.einsum("ij,ij->i", hits.normal[h[own_h]], d_b[h[own_h]]))
-        mat_h = hits.material[h]
+        # physics on the rays that hit something in the world (the sky is a large part of a sweep)
+        hit_local = np.flatnonzero(hits.object_id != NO_HIT)
+        h = free[hit_local]
+        r_h = hits.range_m[hit_local]
+        obj_h = hits.object_id[hit_local]
+        cos_h = np.abs(np.einsum("ij,ij->i", hits.normal[hit_local], d_w[h]))
+        if own_body is not None:  # own-ship normals are in its body frame: use the body-frame direction
+            on_carrier, d_b = own_body
+            own_h = np.flatnonzero(on_carrier[h])
+            cos_h[own_h] = np.abs(np.einsum("ij,ij->i", hits.normal[hit_local[own_h]], d_b[h[own_h]]))
+        mat_h = hits.material[hit_local]
         reflectance = self.materials["reflectance_905nm"][mat_h].astype(np.float64)
         retro = self.materials["retroreflective"][mat_h]
         source = np.zeros(h.size, dtype=np.uint8)
@@ -216,12 +234,6 @@ class LidarRenderer:
                 foam = self.foam.is_foam(p[:, 0], p[:, 1], times[h[could]])
                 reflectance[could[foam]] = FOAM_REFLECTANCE
         power_h = phys.echo_power(reflectance * cos_h, r_h, self.alpha) / k
-        e = k + (1 if self.alpha > 0 else 0)  # candidates per firing: sub-rays and a weather echo
-        cand_r = np.full((f, e), np.inf)
-        cand_p = np.zeros((f, e))
-        cand_b = np.zeros((f, e), dtype=np.uint8)
-        cand_id = np.full((f, e), -1, dtype=np.int32)
-        cand_src = np.zeros((f, e), dtype=np.uint8)
         row, col = h // k, h % k
         cand_r[row, col] = r_h
         cand_p[row, col] = power_h
