@@ -271,3 +271,45 @@ def test_dual_returns_appear_on_edges(write_scenario, tmp_path):
     both = second & (np.abs(((d["azimuth_deg"] + 180) % 360) - 180) < az_post + 1.0)
     assert both.sum() > 5  # second returns at the post's edges
     assert not (second & (np.abs(((d["azimuth_deg"] + 180) % 360) - 180) > 30) & (d["object_id"] == 2)).any()
+
+
+def test_same_seed_same_bytes(write_scenario, tmp_path):
+    data = scenario(tmp_path, obstacles=[wall(tmp_path, 20.0)], environment={"sea_state": 4, "wind_speed_mps": 12, "rain_mm_per_h": 4})
+    a = render(write_scenario, tmp_path, data, "a")
+    b = render(write_scenario, tmp_path, data, "b")
+    files = sorted(p.relative_to(a) for p in (a / "lidar").rglob("*") if p.is_file())
+    assert len(files) == 3  # the PCAP and two sweeps
+    for rel in files:
+        assert (a / rel).read_bytes() == (b / rel).read_bytes(), rel
+    data["seed"] = 4
+    c = render(write_scenario, tmp_path, data, "c")
+    assert (a / "lidar" / "hdl32e.pcap").read_bytes() != (c / "lidar" / "hdl32e.pcap").read_bytes()
+
+
+def test_position_packets_carry_the_own_ship_gprmc(write_scenario, tmp_path):
+    from raysim.recording.nmea import checksum
+
+    data = scenario(tmp_path, duration=2.2)
+    rec = render(write_scenario, tmp_path, data)
+    raw = (rec / "lidar" / "hdl32e.pcap").read_bytes()
+    offset, found = 24, []
+    while offset < len(raw):
+        ts_sec, ts_usec, incl, _ = struct.unpack_from("<IIII", raw, offset)
+        frame = raw[offset + 16 : offset + 16 + incl]
+        if struct.unpack_from(">H", frame, 36)[0] == 8308:
+            payload = frame[42:]
+            assert len(payload) == 512
+            stamp_us = struct.unpack_from("<I", payload, 198)[0]
+            text = payload[206:].split(b"\x00")[0].decode("ascii")
+            found.append((ts_sec + ts_usec * 1e-6, stamp_us, text))
+        offset += 16 + incl
+    assert [round(t - 1496318400.0, 3) for t, _, _ in found] == [0.0, 1.0, 2.0]
+    assert [s for _, s, _ in found] == [0, 1_000_000, 2_000_000]
+    for _, _, text in found:
+        body, cs = text[1:].split("*")
+        assert text.startswith("$GPRMC,") and checksum(body) == cs
+        fields = body.split(",")
+        lat = int(fields[3][:2]) + float(fields[3][2:]) / 60
+        lon = int(fields[5][:3]) + float(fields[5][3:]) / 60
+        assert (lat, lon) == pytest.approx(tuple(ORIGIN), abs=1e-6) and fields[4] == "N" and fields[6] == "E"
+        assert fields[9] == "010617"
