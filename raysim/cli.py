@@ -161,10 +161,32 @@ def cmd_import_hilsim(args) -> int:
     return 0
 
 
-def cmd_bench(args) -> int:
-    from raysim import benchmarking
+BENCHMARKS = ("ray_engine", "lidar")
 
-    return benchmarking.main(quick=args.quick, json_path=args.json)
+
+def cmd_bench(args) -> int:
+    """Run the benchmark scripts of the source tree; print their tables (results files untouched)."""
+    import importlib.util
+    import json
+    import tempfile
+
+    folder = Path(__file__).resolve().parents[1] / "benchmarks"
+    if not folder.is_dir():
+        raise InputError("command line", "bench", f"needs the source tree's benchmarks/ folder (not found at {folder})")
+    combined = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for name in BENCHMARKS:
+            spec = importlib.util.spec_from_file_location(f"raysim_bench_{name}", folder / f"{name}.py")
+            module = importlib.util.module_from_spec(spec)
+            spec.loader.exec_module(module)
+            json_path = Path(tmp) / f"{name}.json"
+            argv = ["--out", str(Path(tmp) / f"{name}.md"), "--json", str(json_path)] + (["--quick"] if args.quick else [])
+            if module.main(argv) != 0:
+                return 1
+            combined[name] = json.loads(json_path.read_text(encoding="utf-8"))
+    if args.json:
+        args.json.write_text(json.dumps(combined, indent=2) + "\n", encoding="utf-8")
+    return 0
 
 
 COMMANDS = {"render": cmd_render, "run": cmd_run, "import-hilsim": cmd_import_hilsim, "bench": cmd_bench}

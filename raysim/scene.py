@@ -14,12 +14,17 @@ Static objects (motion :class:`raysim.motion.Stationary`)
     float32 keeps sub-millimetre precision at kilometre-scale coordinates; ray
     origins are shifted by the same offset, in float64, before casting.
 Moving objects
-    Each distinct mesh (same vertex and face bytes) gets its own
-    ``RaycastingScene`` built once in its body frame and never rebuilt. For a
-    batch, candidate rays are culled (below), the object's pose is evaluated
-    at each candidate ray's own time, the rays are moved into the body frame
-    (``o' = R^T (o - p)``, ``d' = R^T d``), cast, and hits nearer than the
-    current best replace it (normals rotated back to the world frame).
+    All moving objects share ONE ``RaycastingScene``, the *atlas*, built once in
+    ``__init__`` and never rebuilt: each object's body-frame mesh sits in its own
+    cell of a compact grid (cells farther apart than any two bounding spheres).
+    For a batch, candidate rays are culled (below), each object's pose is
+    evaluated at each candidate ray's own time, the rays are moved into the body
+    frame (``o' = R^T (o - p)``, ``d' = R^T d``), started at the entry of the
+    object's bounding sphere and shifted into its cell, and ALL objects' rays are
+    cast in one call; a hit counts when it is on the ray's own object (nothing in
+    another cell can come first), and hits nearer than the current best replace
+    it (range = sphere entry + Embree's distance, normals rotated back to the
+    world frame). One Embree call per batch whatever the number of objects.
 The sea
     The flat analytic plane ``z = 0`` (:func:`intersect_sea`).
 
@@ -648,9 +653,8 @@ class _StaticPart:
 
 @dataclass
 class _Body:
-    """A mesh's body-frame Open3D scene, shared by the objects that use the same mesh."""
+    """A distinct moving mesh (shared by the objects that use the same one)."""
 
-    scene: o3d.t.geometry.RaycastingScene
     radius_m: float  # max vertex distance from the body origin
 
 
@@ -905,6 +909,7 @@ class Scene:
         self._mover_materials = (
             np.concatenate([m.face_material for m in self._movers]) if self._movers else np.zeros(0, np.int16)
         )
+        self._atlas, self._atlas_offset, self._mover_radius = self._build_atlas(self._movers)
 
     # ------------------------------------------------------------------ build
 
@@ -954,9 +959,41 @@ class Scene:
             if key not in bodies:
                 v = np.asarray(obj.vertices_m, dtype=np.float64)
                 radius = float(np.sqrt((v * v).sum(axis=1).max())) if len(v) else 0.0
-                bodies[key] = _Body(_make_scene(v, obj.faces, self.nthreads), radius)
+                bodies[key] = _Body(radius)
             movers.append(_Mover(obj, bodies[key], np.asarray(obj.face_material, dtype=np.int16)))
         return movers
+
+    def _build_atlas(self, movers: list[_Mover]):
+        """ONE Open3D scene holding every moving object's body-frame mesh in its own cell.
+
+        Object k's mesh sits at ``offset[k]``, the centre of cell k of a compact cubic grid
+        whose spacing exceeds twice the largest bounding radius, so the cells' bounding
+        spheres are disjoint and coordinates stay within a few kilometres (float32 keeps
+        sub-millimetre precision). A batch casts all objects' candidate rays in one call:
+        each ray starts at the entry of its own object's sphere, so a hit on its own
+        object, if any, comes before anything in another cell (geometry id = object).
+
+        Returns
+        -------
+        scene, offsets (K, 3) float64, radii (K,) float64
+        """
+        if not movers:
+            return None, np.zeros((0, 3)), np.zeros(0)
+        radii = np.array([m.body.radius_m for m in movers]) + _SPHERE_PAD_M
+        spacing = 2.0 * float(radii.max()) + 10.0
+        side = int(np.ceil(len(movers) ** (1.0 / 3.0)))
+        index = np.arange(len(movers))
+        cells = np.stack([index % side, (index // side) % side, index // (side * side)], axis=1).astype(np.float64)
+        offsets = (cells - (side - 1) / 2.0) * spacing
+        scene = o3d.t.geometry.RaycastingScene(nthreads=self.nthreads)
+        for k, (mover, offset) in enumerate(zip(movers, offsets)):
+            gid = scene.add_triangles(
+                o3d.core.Tensor(np.ascontiguousarray(np.asarray(mover.obj.vertices_m, dtype=np.float64) + offset, dtype=np.float32)),
+                o3d.core.Tensor(np.ascontiguousarray(mover.obj.faces, dtype=np.uint32)),
+            )
+            if gid != k:
+                raise RuntimeError(f"unexpected Open3D geometry id {gid}")
+        return scene, offsets, radii
 
     @property
     def static_raycasting_scene(self) -> o3d.t.geometry.RaycastingScene | None:
@@ -970,8 +1007,13 @@ class Scene:
 
     @property
     def n_bodies(self) -> int:
-        """Number of distinct body-frame acceleration structures (moving meshes)."""
+        """Number of distinct moving meshes (each moving object has its own copy in the atlas)."""
         return len({id(m.body) for m in self._movers})
+
+    @property
+    def n_atlas_geometries(self) -> int:
+        """Meshes in the moving objects' one acceleration structure (one per moving object)."""
+        return 0 if self._atlas is None else len(self._movers)
 
     # ------------------------------------------------------------------- cast
 
@@ -1191,7 +1233,7 @@ class Scene:
 
         Candidate (ray, object) pairs are selected for all objects at once, their
         poses are evaluated with one call per object, transformed with one
-        vectorised pass, cast with one Open3D call per object, and the nearest
+        vectorised pass, cast with one Open3D call for all objects (the atlas), and the nearest
         hit per ray is merged in one pass.
         """
         if not self.cull:  # brute force, one object at a time (bounded memory)
@@ -1326,28 +1368,32 @@ class Scene:
         if inside.size == 0:
             return None
         ray, label, rot, d = ray[inside], label[inside], rot[inside], d[inside]
-        rays = rays64[inside].reshape(-1, 6).astype(np.float32)
-        cut = np.searchsorted(label, np.arange(len(self._movers) + 1))
-        t_parts, prim_parts, normal_parts = [], [], []
-        for k in np.flatnonzero(cut[1:] > cut[:-1]).tolist():
-            res = self._movers[k].body.scene.cast_rays(
-                o3d.core.Tensor.from_numpy(rays[cut[k] : cut[k + 1]]), nthreads=self.nthreads
-            )
-            t_parts.append(res["t_hit"].numpy())
-            prim_parts.append(res["primitive_ids"].numpy().view(np.int32))
-            normal_parts.append(res["primitive_normals"].numpy())
-        t = np.concatenate(t_parts)
+        body = rays64[inside]
+        # one Open3D call for all objects (the atlas): each ray starts where it enters its
+        # object's bounding sphere, moved into the object's atlas cell
+        o_b, d_b = body[:, 0], body[:, 1]
+        b = np.einsum("ni,ni->n", o_b, d_b)
+        c = np.einsum("ni,ni->n", o_b, o_b) - np.take(self._mover_radius, label) ** 2
+        t_entry = np.maximum(0.0, -b - np.sqrt(np.maximum(b * b - c, 0.0)))
+        shifted = np.empty((ray.size, 6), dtype=np.float32)
+        shifted[:, :3] = o_b + t_entry[:, None] * d_b + np.take(self._atlas_offset, label, axis=0)
+        shifted[:, 3:] = d_b
+        res = self._atlas.cast_rays(o3d.core.Tensor.from_numpy(shifted), nthreads=self.nthreads)
+        own = res["geometry_ids"].numpy().view(np.int32) == label
+        t = np.where(own, t_entry + res["t_hit"].numpy(), np.inf)
+        prim_all = res["primitive_ids"].numpy().view(np.int32)
+        normal_all = res["primitive_normals"].numpy()
         better = t < np.take(hits.range_m, ray)
         if batch.max_range is not None:
             better &= t <= (np.take(batch.max_range, ray) if batch.max_range.ndim else float(batch.max_range))
         sel = np.flatnonzero(better)
         if sel.size == 0:
             return None
-        normal = np.concatenate(normal_parts)[sel].astype(np.float64)
+        normal = normal_all[sel].astype(np.float64)
         n_world = np.einsum("nij,nj->ni", rot[sel], normal)
         flip = np.einsum("ni,ni->n", n_world, d[sel]) > 0
         n_world[flip] *= -1.0
-        prim = np.concatenate(prim_parts)[sel]
+        prim = prim_all[sel]
         return {"ray": ray[sel], "label": label[sel], "t": t[sel].astype(np.float64), "prim": prim, "normal": n_world}
 
     def _merge_moving(self, hits: Hits, batch: _Batch, found: dict[str, np.ndarray] | None) -> None:

@@ -376,7 +376,7 @@ def test_culling_matches_brute_force_with_50_moving_boxes():
     assert (ref_ids >= 0).sum() > 1000  # the test means something
     assert len(np.unique(ref_ids[ref_ids >= 0])) > 10 and (ref_ids == 50).sum() > 100
     np.testing.assert_array_equal(culled.object_id, ref_ids)
-    np.testing.assert_allclose(culled.range_m, ref_range, rtol=0, atol=1e-6)
+    np.testing.assert_allclose(culled.range_m, ref_range, rtol=0, atol=5e-4)  # float32 rounding differs: the engine casts from near each object
     no_cull = Scene(objects, sea=False, cull=False).cast(o, d, times)
     np.testing.assert_array_equal(no_cull.object_id, culled.object_id)
     # with the sea (culling by the sea's nearer hits) and a range limit, still exact
@@ -389,11 +389,13 @@ def test_culling_matches_brute_force_with_50_moving_boxes():
     np.testing.assert_array_equal(with_sea.object_id, exp_ids)
 
 
-def test_objects_sharing_a_mesh_share_one_body_scene():
+def test_moving_objects_share_one_acceleration_structure():
     box = trimesh.creation.box(extents=(2, 2, 2))
     objs = [make_object(i, box, ConstantVelocity((10.0 * (i + 1), 0.0, 0.0), (1.0, 0.0, 0.0))) for i in range(5)]
     objs.append(make_object(9, trimesh.creation.box(extents=(3, 2, 2)), ConstantVelocity((0.0, 10.0, 0.0), (0.0, 0.0, 0.0), 0, 1)))
-    assert Scene(objs).n_bodies == 2
+    scene = Scene(objs)
+    assert scene.n_bodies == 2  # distinct meshes
+    assert scene.n_atlas_geometries == 6  # one structure holding each moving object once
 
 
 # ------------------------------------------------------------------- edges
