@@ -96,7 +96,8 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _load(args) -> "Scenario":  # noqa: F821
+def _load(args):
+    """The scenario of the command line, with its overrides applied."""
     from raysim.scenario import load_scenario, with_overrides
 
     scenario = load_scenario(args.scenario)

@@ -83,8 +83,8 @@ class World:
     def own_ship(self) -> WorldObject:
         return self.objects[0]
 
-    def scene_objects(self) -> list["SceneObject"]:  # noqa: F821
-        """The objects as the ray engine wants them."""
+    def scene_objects(self) -> list:
+        """The objects as the ray engine wants them (:class:`raysim.scene.SceneObject`)."""
         from raysim.scene import SceneObject
 
         return [SceneObject(o.object_id, o.mesh.vertices_m, o.mesh.faces, o.mesh.face_material, o.motion) for o in self.objects]
