@@ -14,6 +14,7 @@ Work is done a chunk of packets (about one revolution) at a time: memory stays f
 from __future__ import annotations
 
 import datetime as dt
+import time
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -90,6 +91,8 @@ class LidarRenderer:
         self.start_unix_s = s.start_time.timestamp()
         self.n_cycles = int(np.floor(s.duration_s / hdl32e.CYCLE_DT_S + 1e-9))
         self.n_packets = self.n_cycles // self.cycles_per_packet
+        #: (scenario seconds, wall seconds) of each chunk of the last run (benchmarks read it)
+        self.chunk_wall_s: list[tuple[float, float]] = []
 
     # ------------------------------------------------------------------ geometry
 
@@ -362,6 +365,7 @@ class LidarRenderer:
             pcap = PcapWriter(handle)
             starts = range(0, self.n_packets, chunk_packets)
             for first_packet in (progress(starts) if progress else starts):
+                chunk_started = time.perf_counter()
                 packets_here = min(chunk_packets, self.n_packets - first_packet)
                 k0 = first_packet * self.cycles_per_packet
                 cycles = k0 + np.arange(packets_here * self.cycles_per_packet)
@@ -390,6 +394,7 @@ class LidarRenderer:
                         self._flush(sweeps_dir, current_rev, pending, counts)
                         pending, current_rev = [], int(rev)
                     pending.append({k: v[point_rev == rev] for k, v in pts.items()})
+                self.chunk_wall_s.append((t[-1] + hdl32e.CYCLE_DT_S - t[0], time.perf_counter() - chunk_started))
             # the last revolution is written only if it is complete
             t_next = self.n_packets * self.cycles_per_packet * hdl32e.CYCLE_DT_S
             if np.floor((self.cfg.azimuth0_deg + 360.0 * self.cfg.rotation_hz * t_next) / 360.0) > current_rev:
