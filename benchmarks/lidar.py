@@ -68,6 +68,19 @@ def steady_state(scenario, duration_s: float) -> tuple[float, float]:
     return float(np.median(ratio)), float(ratio.mean())
 
 
+def peak_memory_mb(duration_s: float) -> float:
+    """Peak resident memory (MB) of a ``raysim render --sensors lidar`` process of that duration."""
+    import subprocess
+
+    with tempfile.TemporaryDirectory() as tmp:
+        proc = subprocess.Popen([sys.executable, "-m", "raysim.cli", "render", str(ROOT / "scenarios" / "busy_open_sea.yaml"),
+                                 "-o", str(Path(tmp) / "rec"), "--duration", str(duration_s), "--sensors", "lidar",
+                                 "--no-progress"], stdout=subprocess.DEVNULL, cwd=ROOT)
+        _, status, usage = os.wait4(proc.pid, 0)
+        proc.returncode = os.waitstatus_to_exitcode(status)
+    return usage.ru_maxrss / 1024.0
+
+
 def raw_embree_rays_per_s(scenario, t_s: float, repeats: int) -> tuple[float, int]:
     """Raw Open3D casting of one revolution's world rays against the frozen scene at t_s."""
     world = World(scenario)
@@ -117,6 +130,7 @@ def main(argv=None) -> int:
     raw, n_rays = raw_embree_rays_per_s(scenario, 60.0, 5 if not args.quick else 2)
     points = manifest["counts"]["lidar/points"] / long
     lidar_rays_per_s = sim_rays_per_s / marginal
+    memory = {d: peak_memory_mb(d) for d in ((2.0, 6.0) if args.quick else (10.0, 60.0))}
     rows = [
         ("simulated firings per second of scenario", f"{sim_rays_per_s:,.0f}"),
         ("points per second of scenario (busy_open_sea)", f"{points:,.0f}"),
@@ -128,6 +142,7 @@ def main(argv=None) -> int:
         ("renderer rays/s (marginal)", f"{lidar_rays_per_s / 1e6:.2f} M"),
         (f"raw Embree rays/s (Open3D cast_rays, same {n_rays:,} rays, frozen scene)", f"{raw / 1e6:.2f} M"),
         ("**fraction of raw Embree**", f"**{lidar_rays_per_s / raw:.2f}**"),
+        *[(f"peak memory of a {d:g} s render, MB", f"{mb:.0f}") for d, mb in memory.items()],
     ]
     cpu = next((line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo") if line.startswith("model name")), "?")
     text = "\n".join([
