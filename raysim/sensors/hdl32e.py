@@ -93,10 +93,11 @@ def decoder_azimuths_centideg(block_az: np.ndarray, dual: bool = False) -> np.nd
     return (rounded % 36000).astype(np.uint16)
 
 
-_COS_AZ = np.cos(np.radians(np.arange(36000) * 0.01))
-_SIN_AZ = np.sin(np.radians(np.arange(36000) * 0.01))
-_COS_EL = np.cos(np.radians(ELEVATION_DEG))
-_SIN_EL = np.sin(np.radians(ELEVATION_DEG))
+#: cosines and sines of the 36000 encoder steps and of the 32 elevations (tables shared with the renderer)
+COS_AZIMUTH_STEP = np.cos(np.radians(np.arange(36000) * 0.01))
+SIN_AZIMUTH_STEP = np.sin(np.radians(np.arange(36000) * 0.01))
+COS_ELEVATION = np.cos(np.radians(ELEVATION_DEG))
+SIN_ELEVATION = np.sin(np.radians(ELEVATION_DEG))
 
 
 def beam_directions(azimuth_centideg: np.ndarray) -> np.ndarray:
@@ -113,9 +114,9 @@ def beam_directions(azimuth_centideg: np.ndarray) -> np.ndarray:
         ``(cos w cos a, -cos w sin a, sin w)`` (cosines from a table of the 36000 encoder steps).
     """
     out = np.empty(azimuth_centideg.shape + (3,))
-    out[..., 0] = _COS_EL * _COS_AZ[azimuth_centideg]
-    out[..., 1] = -_COS_EL * _SIN_AZ[azimuth_centideg]
-    out[..., 2] = _SIN_EL
+    out[..., 0] = COS_ELEVATION * COS_AZIMUTH_STEP[azimuth_centideg]
+    out[..., 1] = -COS_ELEVATION * SIN_AZIMUTH_STEP[azimuth_centideg]
+    out[..., 2] = SIN_ELEVATION
     return out
 
 

@@ -297,17 +297,16 @@ class LidarRenderer:
             keep[:, 1] &= units[:, 1] != units[:, 0]
         cc, rr, jj = np.nonzero(keep)
         d = units[cc, rr, jj].astype(np.float64) * hdl32e.DISTANCE_UNIT_M
-        a = np.radians(fire.firing_azimuth[cc, jj].astype(np.float64) * 0.01)
-        w = np.radians(hdl32e.ELEVATION_DEG[jj])
-        xy = d * np.cos(w)
+        az = fire.firing_azimuth[cc, jj]
+        xy = d * hdl32e.COS_ELEVATION[jj]
         arrays = {
-            "x": (xy * np.cos(a)).astype(np.float32),
-            "y": (-xy * np.sin(a)).astype(np.float32),
-            "z": (d * np.sin(w) + hdl32e.Z_OFFSET_M[jj]).astype(np.float32),
+            "x": (xy * hdl32e.COS_AZIMUTH_STEP[az]).astype(np.float32),
+            "y": (-xy * hdl32e.SIN_AZIMUTH_STEP[az]).astype(np.float32),
+            "z": (d * hdl32e.SIN_ELEVATION[jj] + hdl32e.Z_OFFSET_M[jj]).astype(np.float32),
             "intensity": fire.reflectivity[cc, rr, jj].astype(np.uint8),
             "ring": hdl32e.RING[jj],
             "time": fire.cycle_time_s[cc] + jj * hdl32e.FIRING_DT_S,
-            "azimuth_deg": (fire.firing_azimuth[cc, jj].astype(np.float64) * 0.01).astype(np.float32),
+            "azimuth_deg": (az.astype(np.float64) * 0.01).astype(np.float32),
             "object_id": fire.object_id[cc, rr, jj].astype(np.int32),
             "return_source": fire.source[cc, rr, jj].astype(np.uint8),
             "return_index": rr.astype(np.uint8),
