@@ -93,6 +93,38 @@ def mast_view(world: World, scene: Scene, t_s: float, size=(1280, 480), fov_deg:
     return Image.fromarray(shade(hits, directions).reshape(h, w, 3))
 
 
+def lidar_sweep_view(world: World, t_s: float, size_px: int = 900, span_m: float = 100.0) -> Image.Image:
+    """One HDL-32E revolution starting at t, bird's-eye in the sensor frame, coloured by intensity."""
+    from raysim.sensors import hdl32e
+    from raysim.sensors.carrier import CarrierScene
+    from raysim.sensors.lidar import LidarRenderer
+
+    renderer = LidarRenderer(world, CarrierScene(world.scene_objects(), sea_material=material_index("sea")))
+    n = int(round(hdl32e.cycles_per_revolution(renderer.cfg.rotation_hz) / 12)) * 12
+    t = (int(t_s / hdl32e.CYCLE_DT_S) + np.arange(n)) * hdl32e.CYCLE_DT_S
+    block = hdl32e.block_azimuth_centideg(t, renderer.cfg.rotation_hz)
+    azimuth = hdl32e.decoder_azimuths_centideg(block.reshape(-1, 12)).reshape(-1, 32)
+    points, _ = renderer.points(renderer.measure(t, block, azimuth))
+    image = Image.new("RGB", (size_px, size_px), (8, 10, 16))
+    scale = size_px / (2 * span_m)
+    # sensor frame, bow up: image x = -y (left is left), image y = -x
+    u = (size_px / 2 - points["y"] * scale).astype(int)
+    v = (size_px / 2 - points["x"] * scale).astype(int)
+    keep = (u >= 0) & (u < size_px) & (v >= 0) & (v < size_px)
+    level = np.clip(points["intensity"][keep].astype(float) / 60.0, 0.0, 1.0)
+    colour = np.stack([255 * level, 80 + 175 * (1 - np.abs(level - 0.5) * 2), 255 * (1 - level)], axis=1).astype(np.uint8)
+    pixels = np.asarray(image).copy()
+    pixels[v[keep], u[keep]] = colour
+    image = Image.fromarray(pixels)
+    draw = ImageDraw.Draw(image)
+    for ring_m in (25, 50, 75, 100):
+        r = ring_m * scale
+        draw.ellipse([size_px / 2 - r, size_px / 2 - r, size_px / 2 + r, size_px / 2 + r], outline=(60, 60, 70))
+        draw.text((size_px / 2 + 3, size_px / 2 - r + 2), f"{ring_m} m", fill=(120, 120, 130))
+    draw.text((8, 8), f"HDL-32E, one revolution at t = {t_s:g} s, bow up, colour = reflectivity", fill=(200, 200, 200))
+    return image
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("scenario", nargs="?", type=Path, default=REPO / "scenarios" / "busy_open_sea.yaml")
@@ -103,6 +135,7 @@ def main() -> None:
     scene = Scene(world.scene_objects(), sea=True, sea_material=material_index("sea"))
     top_view(world, scene, args.time).save(HERE / f"{scenario.name}_top.png", optimize=True)
     mast_view(world, scene, args.time).save(HERE / f"{scenario.name}_mast.png", optimize=True)
+    lidar_sweep_view(world, args.time).save(HERE / f"{scenario.name}_lidar.png", optimize=True)
 
 
 if __name__ == "__main__":
