@@ -157,14 +157,23 @@ class LidarRenderer:
         pos = poses.position_m + np.einsum("nij,j->ni", poses.rotation(), self.mount_translation)
         c, _, k, _ = directions_s.shape
         frac = np.repeat(np.arange(hdl32e.N_LASERS) * (hdl32e.FIRING_DT_S / hdl32e.CYCLE_DT_S), k)  # (32 K,)
-        r0, dr = rot[:-1], rot[1:] - rot[:-1]
-        d = directions_s.reshape(c, hdl32e.N_LASERS * k, 3).transpose(0, 2, 1)  # (C, 3, 32 K)
-        d_world = r0 @ d + (dr @ d) * frac
-        # beam origins are (0, 0, z_offset): only the third column of the rotation matters
-        z = np.repeat(origins_s[0, :, 0, 2], k)
-        o_world = (r0[:, :, 2:3] + dr[:, :, 2:3] * frac) * z + pos[:-1, :, None] + (pos[1:] - pos[:-1])[:, :, None] * frac
-        o_world = o_world.transpose(0, 2, 1).reshape(c, hdl32e.N_LASERS, k, 3)
-        d_world = d_world.transpose(0, 2, 1).reshape(c, hdl32e.N_LASERS, k, 3)
+        # row-vector form keeps the (C, 32 K, 3) layout contiguous: d_world = d R^T
+        r0t = np.ascontiguousarray(rot[:-1].transpose(0, 2, 1))
+        drt = np.ascontiguousarray((rot[1:] - rot[:-1]).transpose(0, 2, 1))
+        d = directions_s.reshape(c, hdl32e.N_LASERS * k, 3)
+        f = frac[None, :, None]
+        d_world = d @ r0t
+        d_world += (d @ drt) * f
+        # origins in homogeneous coordinates [x, y, z, 1] (the same for every cycle): one affine
+        # product per cycle, o_world = [o, 1] [R^T; p]
+        homogeneous = np.ones((hdl32e.N_LASERS * k, 4))
+        homogeneous[:, :3] = origins_s[0].reshape(-1, 3)
+        a0 = np.concatenate([r0t, pos[:-1, None, :]], axis=1)  # (C, 4, 3)
+        da = np.concatenate([drt, (pos[1:] - pos[:-1])[:, None, :]], axis=1)
+        o_world = homogeneous @ a0
+        o_world += (homogeneous @ da) * f
+        o_world = o_world.reshape(c, hdl32e.N_LASERS, k, 3)
+        d_world = d_world.reshape(c, hdl32e.N_LASERS, k, 3)
         t_firing = cycle_time_s[:, None] + np.arange(hdl32e.N_LASERS)[None, :] * hdl32e.FIRING_DT_S
         return o_world, d_world, t_firing
 
@@ -233,8 +242,10 @@ class LidarRenderer:
             # foam is looked up only where a foam echo could be detected at all
             could = np.nonzero(sea & (phys.echo_power(FOAM_REFLECTANCE * cos_h, r_h, self.alpha) >= self.threshold))[0]
             if could.size:
-                p = o_w[h[could]] + r_h[could, None] * d_w[h[could]]
-                foam = self.foam.is_foam(p[:, 0], p[:, 1], times[h[could]])
+                rays = h[could]
+                x = o_w[rays, 0] + r_h[could] * d_w[rays, 0]
+                y = o_w[rays, 1] + r_h[could] * d_w[rays, 1]
+                foam = self.foam.is_foam(x, y, times[rays])
                 reflectance[could[foam]] = FOAM_REFLECTANCE
         power_h = phys.echo_power(reflectance * cos_h, r_h, self.alpha) / k
         row, col = h // k, h % k
