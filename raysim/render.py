@@ -57,8 +57,14 @@ def _render_lidar(ctx: "RenderContext") -> None:
     render_lidar(ctx)
 
 
+def _render_radar(ctx: "RenderContext") -> None:
+    from raysim.sensors.radar import render_radar
+
+    render_radar(ctx)
+
+
 #: Sensor name -> renderer(context). Sensors register here as they are implemented.
-SENSOR_RENDERERS: dict[str, Callable[[RenderContext], None]] = {"lidar": _render_lidar}
+SENSOR_RENDERERS: dict[str, Callable[[RenderContext], None]] = {"lidar": _render_lidar, "radar": _render_radar}
 
 
 @dataclass(frozen=True)

@@ -77,7 +77,6 @@ small thread pool (numpy releases the GIL in its loops).
 from __future__ import annotations
 
 import hashlib
-import math
 import os
 import threading
 from concurrent.futures import ThreadPoolExecutor
@@ -87,8 +86,8 @@ from typing import Callable, Sequence
 import numpy as np
 import open3d as o3d
 
-from raysim.motion import Motion, Stationary
-from raysim.pose import Poses
+from raysim.motion import ConstantVelocity, Motion, SampledTrack, ShipMotion, Stationary, WaveMotion
+from raysim.pose import rotation_matrices
 
 SEA_ID = -2
 """Object id reported for hits on the sea surface."""
@@ -195,6 +194,36 @@ class Hits:
     def hit(self) -> np.ndarray:
         """(N,) bool, True where the ray hit something (object or sea)."""
         return self.object_id != NO_HIT
+
+
+@dataclass(frozen=True)
+class Carrier:
+    """The rays of a :meth:`Scene.cast` batch in the body frame of the object carrying the sensor.
+
+    A sensor on the own ship knows its rays in the ship's body frame (the mount
+    is fixed) and builds the world rays from them with the ship's pose at each
+    ray's time; passed along, they let the engine cast the carrier without any
+    pose evaluation or culling (see the module docstring).
+
+    Attributes
+    ----------
+    object_id : int
+        Truth id of the carrying object; must be a moving object of the scene
+        (otherwise the carrier is ignored and the batch is cast as usual).
+    origins_body_m : (N, 3) float64
+        The batch's ray origins in the carrier's body frame at each ray's time, metres.
+    directions_body : (N, 3) float
+        The batch's unit ray directions in that frame.
+    rotation : (N, 3, 3) float64 or None
+        Body-to-world rotation of the carrier at each ray's time, used only to turn
+        the normals of carrier hits into the world frame; if None, the engine
+        evaluates the carrier's pose at the times of those hits.
+    """
+
+    object_id: int
+    origins_body_m: np.ndarray
+    directions_body: np.ndarray
+    rotation: np.ndarray | None = None
 
 
 # ------------------------------------------------------------ ray geometry
@@ -364,19 +393,27 @@ def _sphere_cells(
     return _SphereCells(np.maximum(dist - rs, 0.0), a0, a1, e0, e1)
 
 
+def _gather_columns(a: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """(3, P) float64: rows ``rows`` of a C-contiguous (N, 3) float64 array, as columns."""
+    out = np.empty((3, rows.size))
+    r3 = rows * 3
+    flat = a.reshape(-1)
+    for axis in range(3):
+        np.take(flat[axis:], r3, out=out[axis], mode="clip")  # in range; "clip" avoids a buffer
+    return out
+
+
 def _pairs_reach_spheres(
-    batch: "_Batch", ray: np.ndarray, centres: np.ndarray, radii: np.ndarray, best: np.ndarray
+    o: np.ndarray, d: np.ndarray, centres: np.ndarray, radii: np.ndarray, best: np.ndarray
 ) -> np.ndarray:
     """Which rays enter their sphere ahead of their origin and before their current best.
 
     Parameters
     ----------
-    batch : _Batch
-        The rays.
-    ray : (P,) int
-        Ray of each pair.
+    o, d : (3, P) float64
+        Origin (metres) and unit direction of each pair's ray.
     centres : (3, P) float64
-        Sphere centre of each pair (x, y, z rows), metres.
+        Sphere centre of each pair, metres.
     radii : (P,) float64
         Sphere radius of each pair, metres.
     best : (P,) float64
@@ -386,19 +423,14 @@ def _pairs_reach_spheres(
     -------
     (P,) bool
     """
-    r3 = ray * 3
-    o_flat = batch.origins.reshape(-1)
-    d_flat = batch.directions.reshape(-1)
-    w = np.empty(ray.size)
-    dw = np.empty(ray.size)
-    b = np.zeros(ray.size)
+    w = np.empty(radii.size)
+    dw = np.empty(radii.size)
+    b = np.zeros(radii.size)
     c = radii * radii
     np.negative(c, out=c)  # accumulates |w|^2 - r^2
     for axis in range(3):
-        np.take(o_flat[axis:], r3, out=w, mode="clip")
-        np.subtract(centres[axis], w, out=w)
-        np.take(d_flat[axis:], r3, out=dw, mode="clip")
-        dw *= w
+        np.subtract(centres[axis], o[axis], out=w)
+        np.multiply(d[axis], w, out=dw)
         b += dw
         w *= w
         c += w
@@ -411,13 +443,13 @@ def _pairs_reach_spheres(
     return ok
 
 
-def _pairs_hit_boxes(rays: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+def _pairs_hit_boxes(o: np.ndarray, d: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     """Which body-frame rays meet their body's axis-aligned bounding box (slab test).
 
     Parameters
     ----------
-    rays : (P, 2, 3) float64
-        Body-frame origins (``[:, 0]``, metres) and unit directions (``[:, 1]``).
+    o, d : (3, P) float64
+        Body-frame origins (metres) and unit directions.
     lo, hi : (3, P) float64
         Box corners of each pair's body, metres.
 
@@ -426,70 +458,189 @@ def _pairs_hit_boxes(rays: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.nda
     (P,) bool
         False only where the ray surely misses the box (a cheap filter before Embree).
     """
-    near = np.zeros(rays.shape[0])
-    far = np.full(rays.shape[0], np.inf)
+    near = np.zeros(o.shape[1])
+    far = np.full(o.shape[1], np.inf)
     with np.errstate(divide="ignore", invalid="ignore"):
         for axis in range(3):
-            o, d = rays[:, 0, axis], rays[:, 1, axis]
-            inv = 1.0 / d
-            t1 = (lo[axis] - o) * inv
-            t2 = (hi[axis] - o) * inv
+            inv = 1.0 / d[axis]
+            t1 = (lo[axis] - o[axis]) * inv
+            t2 = (hi[axis] - o[axis]) * inv
             np.fmax(near, np.fmin(t1, t2), out=near)  # fmax/fmin ignore nan (o on a slab plane, d = 0)
             np.fmin(far, np.fmax(t1, t2), out=far)
     return near <= far
 
 
-def _swept_sphere(motion: Motion, mesh_radius_m: float, tmin: float, tmax: float) -> tuple[np.ndarray, float]:
-    """Bounding sphere of a body over ``[tmin, tmax]``.
+_KIND_CONSTANT_VELOCITY, _KIND_TRACK, _KIND_OTHER = 0, 1, 2
+
+
+class _PoseBank:
+    """Poses of many moving objects, evaluated together for (object, time) pairs.
+
+    Motions of the known kinds (exactly :class:`raysim.motion.ConstantVelocity`,
+    :class:`raysim.motion.SampledTrack`, or :class:`raysim.motion.ShipMotion` of a
+    ``SampledTrack`` with or without :class:`raysim.motion.WaveMotion`) are packed
+    into parameter tables at construction and evaluated for all their pairs in
+    one vectorised pass per kind, with the same arithmetic as their own
+    ``poses`` (the same numbers). Any other motion is asked object by object.
 
     Parameters
     ----------
-    motion : Motion
-        The body's motion.
-    mesh_radius_m : float
-        Largest distance of a vertex from the body origin, metres.
+    motions : sequence of Motion
+        One per moving object (label = index).
+    """
+
+    def __init__(self, motions: Sequence[Motion]) -> None:
+        k = len(motions)
+        self.motions = list(motions)
+        self.kind = np.full(k, _KIND_OTHER, dtype=np.int8)
+        self.planar = np.zeros(k, dtype=bool)  # pitch and roll are always zero
+        self.cv_position = np.zeros((3, k))
+        self.cv_velocity = np.zeros((3, k))
+        self.cv_yaw = np.zeros(k)
+        self.cv_yaw_rate = np.zeros(k)
+        self.tr_base = np.zeros(k, dtype=np.int64)  # first sample of each track in tr_samples
+        self.tr_last = np.zeros(k)  # n - 1
+        self.tr_imax = np.zeros(k, dtype=np.int64)  # max(n - 2, 0)
+        self.tr_dt = np.ones(k)
+        self.has_waves = np.zeros(k, dtype=bool)
+        self.waves = np.zeros((9, k))  # amplitude, angular frequency, phase of roll, pitch, heave
+        samples, base = [], 0
+        for i, m in enumerate(motions):
+            if type(m) is ConstantVelocity:
+                self.kind[i] = _KIND_CONSTANT_VELOCITY
+                self.planar[i] = True
+                self.cv_position[:, i] = m.position_m
+                self.cv_velocity[:, i] = m.velocity
+                self.cv_yaw[i], self.cv_yaw_rate[i] = m.yaw_rad, m.yaw_rate
+                continue
+            track, waves = None, None
+            if type(m) is SampledTrack:
+                track = m
+            elif type(m) is ShipMotion and type(m.track) is SampledTrack and (m.waves is None or type(m.waves) is WaveMotion):
+                track, waves = m.track, m.waves
+            if track is None:
+                continue
+            n = track.x.shape[0]
+            block = np.stack([track.x, track.y, track.z, track.yaw, track.pitch, track.roll])
+            samples.append(np.concatenate([block, block[:, -1:]], axis=1))  # a pad sample: index i + 1 stays valid
+            self.kind[i] = _KIND_TRACK
+            self.tr_base[i], self.tr_last[i], self.tr_imax[i], self.tr_dt[i] = base, n - 1, max(n - 2, 0), track.dt_s
+            base += n + 1
+            if waves is not None:
+                self.has_waves[i] = True
+                self.waves[:, i] = [*waves.roll, waves.phases[0], *waves.pitch, waves.phases[1], *waves.heave, waves.phases[2]]
+            self.planar[i] = waves is None and not track.pitch.any() and not track.roll.any()
+        self.tr_samples = np.concatenate(samples, axis=1) if samples else np.zeros((6, 0))
+        self.single_kind = k > 0 and bool(np.all(self.kind == self.kind[0]))
+        self.all_planar = bool(self.planar.all())
+
+    def poses(self, label: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None]:
+        """Poses of objects ``label`` at times ``t`` (one per pair).
+
+        Parameters
+        ----------
+        label : (P,) int
+            Object (index into ``motions``) of each pair.
+        t : (P,) float64
+            Time of each pair, seconds.
+
+        Returns
+        -------
+        position : (3, P) float64
+            Body origin in the world frame, metres (x, y, z rows).
+        yaw : (P,) float64
+        pitch, roll : (P,) float64, or None where all of them are zero (planar motions only)
+            FLU Euler angles, radians.
+        """
+        p = label.size
+        position = np.empty((3, p))
+        yaw = np.empty(p)
+        planar = self.all_planar or bool(self.planar[label].all())
+        pitch = None if planar else np.zeros(p)
+        roll = None if planar else np.zeros(p)
+        kinds = [int(self.kind[0])] if self.single_kind else np.unique(self.kind[label]).tolist()
+        for kind in kinds:
+            idx = None if len(kinds) == 1 else np.flatnonzero(self.kind[label] == kind)
+            lab = label if idx is None else label[idx]
+            tt = t if idx is None else t[idx]
+            sel = slice(None) if idx is None else idx
+            if kind == _KIND_CONSTANT_VELOCITY:  # ConstantVelocity.poses
+                position[:, sel] = self.cv_position[:, lab] + tt * self.cv_velocity[:, lab]
+                yaw[sel] = self.cv_yaw[lab] + self.cv_yaw_rate[lab] * tt
+            elif kind == _KIND_TRACK:  # SampledTrack.poses (+ ShipMotion's waves)
+                u = np.clip(tt / self.tr_dt[lab], 0.0, self.tr_last[lab])
+                i = np.minimum(u.astype(np.int64), self.tr_imax[lab])
+                f = u - i
+                i += self.tr_base[lab]
+                a = self.tr_samples[:, i]
+                v = a + (self.tr_samples[:, i + 1] - a) * f
+                w = np.flatnonzero(self.has_waves[lab])
+                if w.size:
+                    wp, tw = self.waves[:, lab[w]], tt[w]
+                    v[5, w] = v[5, w] + wp[0] * np.sin(wp[1] * tw + wp[2])  # roll
+                    v[4, w] = v[4, w] + -(wp[3] * np.sin(wp[4] * tw + wp[5]))  # pitch (marine sign flipped)
+                    v[2, w] += wp[6] * np.sin(wp[7] * tw + wp[8])  # heave
+                position[:, sel] = v[:3]
+                yaw[sel] = v[3]
+                if pitch is not None:
+                    pitch[sel], roll[sel] = v[4], v[5]
+            else:
+                for k in np.unique(lab).tolist():
+                    j = np.flatnonzero(lab == k)
+                    pose = self.motions[k].poses(tt[j])
+                    rows = j if idx is None else idx[j]
+                    position[:, rows] = pose.position_m.T
+                    yaw[rows] = pose.yaw_rad
+                    if pitch is not None:
+                        pitch[rows], roll[rows] = pose.pitch_rad, pose.roll_rad
+        return position, yaw, pitch, roll
+
+
+def _swept_spheres(
+    bank: _PoseBank, speeds: np.ndarray, mesh_radii: np.ndarray, tmin: float, tmax: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Bounding spheres of K moving bodies over ``[tmin, tmax]`` (all bodies at once).
+
+    Each span is cut into k equal parts (more for fast bodies and long spans, at
+    most :data:`_MAX_POSE_SAMPLES`) and the pose is sampled at their middles:
+    within a part the body origin stays within ``speed * span / (2 k)`` of its
+    middle sample.
+
+    Parameters
+    ----------
+    bank : _PoseBank
+        The bodies' motions.
+    speeds : (K,) float64
+        ``max_speed_mps`` of each body.
+    mesh_radii : (K,) float64
+        Largest distance of a vertex from each body origin, metres.
     tmin, tmax : float
         Time span, seconds.
 
     Returns
     -------
-    centre : (3,) float64
-        World position of the sphere's centre, metres.
-    radius : float
-        Radius, metres: covers the mesh at every instant of the span, given that
-        the body origin moves at most ``motion.max_speed_mps``.
-    """
-    speed = float(motion.max_speed_mps)
-    span = max(tmax - tmin, 0.0)
-    # k samples at the middles of k equal sub-spans: within a sub-span the body
-    # origin stays within speed * span / (2 k) of its middle sample.
-    k = int(min(max(math.ceil(speed * span / (2.0 * _SWEEP_MARGIN_M)), 1), _MAX_POSE_SAMPLES))
-    pos = motion.poses(tmin + (np.arange(k) + 0.5) * (span / k)).position_m
-    if k == 1:  # the common case, in plain floats
-        centre = pos[0].copy()
-        path = 0.0
-    else:
-        centre = (pos.min(axis=0) + pos.max(axis=0)) / 2
-        path = float(np.sqrt(((pos - centre) ** 2).sum(axis=1).max()))
-    radius = mesh_radius_m + path + speed * span / (2 * k)
-    return centre, radius + _SPHERE_PAD_M + 1e-6 * (radius + float(np.abs(centre).max()))
-
-
-def _swept_spheres(movers: Sequence["_Mover"], tmin: float, tmax: float) -> tuple[np.ndarray, np.ndarray]:
-    """Swept bounding spheres of moving objects over ``[tmin, tmax]``.
-
-    Returns
-    -------
     centres : (K, 3) float64
-        Metres.
+        World positions of the spheres' centres, metres.
     radii : (K,) float64
-        Metres.
+        Radii, metres: each covers its mesh at every instant of the span.
     """
-    centres = np.empty((len(movers), 3))
-    radii = np.empty(len(movers))
-    for k, m in enumerate(movers):
-        centres[k], radii[k] = _swept_sphere(m.obj.motion, m.body.radius_m, tmin, tmax)
-    return centres, radii
+    span = max(tmax - tmin, 0.0)
+    k = np.clip(np.ceil(speeds * span / (2.0 * _SWEEP_MARGIN_M)), 1, _MAX_POSE_SAMPLES).astype(np.int64)
+    n = k.size
+    if int(k.max(initial=1)) == 1:  # the common case: one sample each
+        pos = bank.poses(np.arange(n), np.full(n, tmin + 0.5 * span))[0]
+        centre, path = pos, 0.0
+    else:
+        start = np.cumsum(k) - k
+        label = np.repeat(np.arange(n), k)
+        j = np.arange(label.size) - start[label]
+        pos = bank.poses(label, tmin + (j + 0.5) * (span / k[label]))[0]
+        centre = (np.minimum.reduceat(pos, start, axis=1) + np.maximum.reduceat(pos, start, axis=1)) / 2
+        dev = pos - centre[:, label]
+        path = np.sqrt(np.maximum.reduceat(np.einsum("ij,ij->j", dev, dev), start))
+    radius = mesh_radii + path + speeds * span / (2 * k)
+    radius += _SPHERE_PAD_M + 1e-6 * (radius + np.abs(centre).max(axis=0))
+    return np.ascontiguousarray(centre.T), radius
 
 
 def _bounding_sphere(points: np.ndarray) -> tuple[np.ndarray, float]:
@@ -791,37 +942,6 @@ def _static_results_part(
             _face_against(normal, j, np.take(directions, j, axis=0))
 
 
-def _insert_blocks(
-    ray: np.ndarray, label: np.ndarray, blocks: dict[int, np.ndarray], n_labels: int
-) -> tuple[np.ndarray, np.ndarray]:
-    """Add whole blocks of rays for some labels to label-grouped (ray, label) pairs.
-
-    Parameters
-    ----------
-    ray, label : (P,) int64
-        Pairs grouped by label, ascending; no pair has a label of ``blocks``.
-    blocks : dict label -> (M,) int64
-        Rays to pair with each of these labels.
-    n_labels : int
-        Number of labels.
-
-    Returns
-    -------
-    ray, label : (P + sum M,) int64
-        Still grouped by label, ascending.
-    """
-    bounds = np.searchsorted(label, np.arange(n_labels + 1))
-    rays, labels = [], []
-    for k in range(n_labels):
-        r = blocks[k] if k in blocks else ray[bounds[k] : bounds[k + 1]]
-        if r.size:
-            rays.append(r)
-            labels.append(np.full(r.size, k, dtype=np.int64))
-    if not rays:
-        return ray, label
-    return np.concatenate(rays), np.concatenate(labels)
-
-
 def _face_against(normal: np.ndarray, rows: np.ndarray, dirs: np.ndarray) -> None:
     """Flip normals (in place) that point along their rays.
 
@@ -900,6 +1020,10 @@ class Scene:
         self._static = self._build_static(static) if static else None
         self._movers = self._build_movers([o for o in objects if not o.is_static])
         self._mover_ids = np.array([m.obj.object_id for m in self._movers], dtype=np.int32)
+        self._mover_speed = np.array([float(m.obj.motion.max_speed_mps) for m in self._movers], dtype=np.float64)
+        self._bank = _PoseBank([m.obj.motion for m in self._movers])
+        self._carrier_scenes: dict[int, o3d.t.geometry.RaycastingScene] = {}
+        self._carrier_lock = threading.Lock()
         n_faces = [len(m.face_material) for m in self._movers]
         self._mover_face_offset = np.concatenate(([0], np.cumsum(n_faces)[:-1])).astype(np.int64)
         boxes = [(m.obj.vertices_m.min(axis=0), m.obj.vertices_m.max(axis=0)) for m in self._movers]
@@ -909,7 +1033,9 @@ class Scene:
         self._mover_materials = (
             np.concatenate([m.face_material for m in self._movers]) if self._movers else np.zeros(0, np.int16)
         )
-        self._atlas, self._atlas_offset, self._mover_radius = self._build_atlas(self._movers)
+        self._mover_radius = np.array([m.body.radius_m for m in self._movers], dtype=np.float64) + _SPHERE_PAD_M
+        self._mover_radius2 = self._mover_radius**2
+        self._atlas, self._atlas_offset = self._build_atlas(self._movers, self._mover_radius)
 
     # ------------------------------------------------------------------ build
 
@@ -963,37 +1089,49 @@ class Scene:
             movers.append(_Mover(obj, bodies[key], np.asarray(obj.face_material, dtype=np.int16)))
         return movers
 
-    def _build_atlas(self, movers: list[_Mover]):
+    def _build_atlas(self, movers: list[_Mover], radii: np.ndarray):
         """ONE Open3D scene holding every moving object's body-frame mesh in its own cell.
 
-        Object k's mesh sits at ``offset[k]``, the centre of cell k of a compact cubic grid
-        whose spacing exceeds twice the largest bounding radius, so the cells' bounding
-        spheres are disjoint and coordinates stay within a few kilometres (float32 keeps
-        sub-millimetre precision). A batch casts all objects' candidate rays in one call:
-        each ray starts at the entry of its own object's sphere, so a hit on its own
-        object, if any, comes before anything in another cell (geometry id = object).
+        Object k's mesh (its own copy, even where objects share a mesh) sits at
+        ``offset[:, k]``, the centre of cell k of a compact cubic grid whose spacing is
+        twice the largest bounding radius plus 10 m, so the cells' bounding spheres are
+        disjoint and coordinates stay within a few kilometres of the atlas origin
+        (float32 keeps sub-millimetre precision). A batch casts all objects' candidate
+        rays in one call: each ray starts at the entry of its own object's sphere, so a
+        hit on its own object, if any, comes before anything in another cell (geometry
+        id = object label).
+
+        Parameters
+        ----------
+        movers : list of _Mover
+        radii : (K,) float64
+            Bounding radius of each body about its origin (padded), metres.
 
         Returns
         -------
-        scene, offsets (K, 3) float64, radii (K,) float64
+        scene : RaycastingScene or None
+        offsets : (3, K) float64
+            Atlas position of each body origin, metres.
         """
         if not movers:
-            return None, np.zeros((0, 3)), np.zeros(0)
-        radii = np.array([m.body.radius_m for m in movers]) + _SPHERE_PAD_M
+            return None, np.zeros((3, 0))
         spacing = 2.0 * float(radii.max()) + 10.0
-        side = int(np.ceil(len(movers) ** (1.0 / 3.0)))
+        side = 1
+        while side**3 < len(movers):
+            side += 1
         index = np.arange(len(movers))
-        cells = np.stack([index % side, (index // side) % side, index // (side * side)], axis=1).astype(np.float64)
+        cells = np.stack([index % side, (index // side) % side, index // (side * side)]).astype(np.float64)
         offsets = (cells - (side - 1) / 2.0) * spacing
         scene = o3d.t.geometry.RaycastingScene(nthreads=self.nthreads)
-        for k, (mover, offset) in enumerate(zip(movers, offsets)):
+        for k, mover in enumerate(movers):
+            vertices = np.asarray(mover.obj.vertices_m, dtype=np.float64) + offsets[:, k]
             gid = scene.add_triangles(
-                o3d.core.Tensor(np.ascontiguousarray(np.asarray(mover.obj.vertices_m, dtype=np.float64) + offset, dtype=np.float32)),
+                o3d.core.Tensor(np.ascontiguousarray(vertices, dtype=np.float32)),
                 o3d.core.Tensor(np.ascontiguousarray(mover.obj.faces, dtype=np.uint32)),
             )
             if gid != k:
                 raise RuntimeError(f"unexpected Open3D geometry id {gid}")
-        return scene, offsets, radii
+        return scene, offsets
 
     @property
     def static_raycasting_scene(self) -> o3d.t.geometry.RaycastingScene | None:
@@ -1023,6 +1161,7 @@ class Scene:
         directions: np.ndarray,
         times_s: np.ndarray,
         max_range_m: float | np.ndarray = np.inf,
+        carrier: Carrier | None = None,
     ) -> Hits:
         """First hit of each ray, each ray seeing the world at its own time.
 
@@ -1036,6 +1175,11 @@ class Scene:
             Time of each ray, seconds since scenario start.
         max_range_m : float or (N,) float
             Hits farther than this count as no hit, metres.
+        carrier : Carrier, optional
+            The same rays in the body frame of the moving object that carries the
+            sensor (the own ship): that object is then cast with these rays as they
+            are, without pose evaluation or culling. The hits are the same as
+            without it (up to float32 round-off).
 
         Returns
         -------
@@ -1053,9 +1197,11 @@ class Scene:
             raise ValueError("max_range_m must be a scalar or (N,)")
         if n == 0:
             return Hits.empty(0)
+        carrier_label = None if carrier is None else self._carrier_label(carrier, n)
+        n_others = len(self._movers) - (carrier_label is not None)
         finite_range = bool(np.any(np.isfinite(max_range)))
         batch = _Batch(origins, dirs, times, max_range if finite_range else None)
-        self._prepare(batch)
+        self._prepare(batch, n_others > 0)
 
         if self._static is not None and batch.static_candidates is None:
             hits = self._cast_static_all(batch)
@@ -1067,15 +1213,21 @@ class Scene:
                 self._merge_static_some(hits, batch, batch.static_candidates)
         if finite_range:
             _drop_beyond(hits, max_range)
-        if self._movers:
-            self._cast_moving(hits, batch)
+        if carrier_label is not None:
+            self._cast_carrier(hits, batch, carrier, carrier_label)
+        if n_others:
+            self._cast_moving(hits, batch, skip=carrier_label)
         return hits
 
     # ---------------------------------------------------------- batch prepass
 
-    def _prepare(self, batch: _Batch) -> None:
-        """Per-batch pre-pass: origin box, direction cells, sea ranges, static candidates."""
-        need_cells = self.cull and (self._static is not None or bool(self._movers))
+    def _prepare(self, batch: _Batch, movers: bool | None = None) -> None:
+        """Per-batch pre-pass: origin box, direction cells, sea ranges, static candidates.
+
+        ``movers``: whether moving objects will be culled (default: the scene has any).
+        """
+        movers = bool(self._movers) if movers is None else movers
+        need_cells = self.cull and (self._static is not None or movers)
         if not need_cells:
             if self.sea:
                 batch.sea_range = intersect_sea(batch.origins[:, 2], batch.directions[:, 2])
@@ -1086,7 +1238,7 @@ class Scene:
         near_table = self._static_near_table(batch) if self._static is not None else None
         if near_table is not None and self._static_fraction(batch, near_table) > _STATIC_CULL_MAX_FRACTION:
             near_table = None
-        if near_table is None and not self._movers:  # cells are of no use: sea only
+        if near_table is None and not movers:  # cells are of no use: sea only
             if self.sea:
                 batch.sea_range = intersect_sea(batch.origins[:, 2], batch.directions[:, 2])
             return
@@ -1228,27 +1380,87 @@ class Scene:
 
     # ----------------------------------------------------------------- moving
 
-    def _cast_moving(self, hits: Hits, batch: _Batch) -> None:
-        """Cast against every moving object, keeping nearer hits (in place).
+    def _carrier_label(self, carrier: Carrier, n: int) -> int | None:
+        """Validate ``carrier`` for a batch of ``n`` rays; the label of its moving object (None if none)."""
+        if carrier.origins_body_m.shape != (n, 3) or carrier.directions_body.shape != (n, 3):
+            raise ValueError("carrier rays must be (N, 3) like the world rays")
+        if carrier.rotation is not None and np.shape(carrier.rotation) != (n, 3, 3):
+            raise ValueError("carrier rotation must be (N, 3, 3)")
+        labels = np.flatnonzero(self._mover_ids == carrier.object_id)
+        if labels.size > 1:
+            raise ValueError(f"carrier id {carrier.object_id} is shared by several moving objects")
+        return int(labels[0]) if labels.size else None
+
+    def _carrier_scene(self, k: int) -> o3d.t.geometry.RaycastingScene:
+        """The body-frame scene of moving object ``k`` alone (built on first use, then kept)."""
+        with self._carrier_lock:
+            if k not in self._carrier_scenes:
+                obj = self._movers[k].obj
+                self._carrier_scenes[k] = _make_scene(obj.vertices_m, obj.faces, self.nthreads)
+            return self._carrier_scenes[k]
+
+    def _cast_carrier(self, hits: Hits, batch: _Batch, carrier: Carrier, k: int) -> None:
+        """Cast every ray, in the carrier's body frame, at the carrier alone (in place).
+
+        No pose and no culling: the caller's body-frame rays go to Embree as they
+        are (one call on a scene holding only the carrier's mesh). Normals of the
+        hits are rotated to the world frame with ``carrier.rotation`` or, if None,
+        with the carrier's pose at the hit rays' times.
+        """
+        n = batch.n
+        o_b = np.ascontiguousarray(carrier.origins_body_m, dtype=np.float64)
+        d_b = np.ascontiguousarray(carrier.directions_body, dtype=np.float64)
+        rays = _scratch("rays", (n, 6))
+        pack_rays(o_b, d_b, None, self._workers, out=rays)
+        res = self._carrier_scene(k).cast_rays(o3d.core.Tensor.from_numpy(rays), nthreads=self.nthreads)
+        t32 = res["t_hit"].numpy()
+        better = t32 < hits.range_m  # misses are inf
+        if batch.max_range is not None:
+            better &= t32 <= batch.max_range
+        j = np.flatnonzero(better)
+        if j.size == 0:
+            return
+        prim = res["primitive_ids"].numpy().view(np.int32)[j]
+        n_body = res["primitive_normals"].numpy()[j].astype(np.float64)
+        if carrier.rotation is not None:
+            rot = np.asarray(carrier.rotation, dtype=np.float64)[j]
+        else:
+            _, yaw, pitch, roll = self._bank.poses(np.full(j.size, k), np.take(batch.times, j))
+            zeros = np.zeros(j.size)
+            rot = rotation_matrices(yaw, zeros if pitch is None else pitch, zeros if roll is None else roll)
+        n_world = np.einsum("nij,nj->ni", rot, n_body)
+        flip = np.einsum("ni,ni->n", n_world, np.take(batch.directions, j, axis=0)) > 0
+        n_world[flip] *= -1.0
+        hits.range_m[j] = t32[j]
+        hits.object_id[j] = self._mover_ids[k]
+        hits.primitive[j] = prim
+        hits.material[j] = self._mover_materials[self._mover_face_offset[k] + prim]
+        hits.normal[j] = n_world
+
+    def _cast_moving(self, hits: Hits, batch: _Batch, skip: int | None = None) -> None:
+        """Cast against every moving object but ``skip`` (the carrier), keeping nearer hits (in place).
 
         Candidate (ray, object) pairs are selected for all objects at once, their
-        poses are evaluated with one call per object, transformed with one
-        vectorised pass, cast with one Open3D call for all objects (the atlas), and the nearest
-        hit per ray is merged in one pass.
+        poses are evaluated in one vectorised pass per motion kind, transformed with
+        one vectorised pass, cast with one Open3D call for all objects (the atlas),
+        and the nearest hit per ray is merged in one pass.
         """
+        n_movers = len(self._movers)
         if not self.cull:  # brute force, one object at a time (bounded memory)
             ray = np.arange(batch.n)
-            steps = np.arange(len(self._movers) + 1)
-            for k in range(len(self._movers)):
-                bounds = np.where(steps > k, batch.n, 0)
-                found = self._cast_pairs(batch, hits, ray, np.full(batch.n, k), bounds, [k])
-                self._merge_moving(hits, batch, found)
+            o, d = np.ascontiguousarray(batch.origins.T), np.ascontiguousarray(batch.directions.T)
+            for k in range(n_movers):
+                if k != skip:
+                    self._merge_moving(hits, self._cast_pairs(batch, hits, ray, np.full(batch.n, k), o, d))
             return
         tmin, tmax = float(batch.times.min()), float(batch.times.max())
         range_cap = np.inf if batch.max_range is None else float(np.max(batch.max_range))
-        centres, radii = _swept_spheres(self._movers, tmin, tmax)
+        centres, radii = _swept_spheres(self._bank, self._mover_speed, self._mover_radius, tmin, tmax)
         cells = _sphere_cells(centres, radii, batch.origin_centre, batch.spread_m)
-        live = np.flatnonzero(cells.near_m <= range_cap)
+        reachable = cells.near_m <= range_cap
+        if skip is not None:
+            reachable[skip] = False
+        live = np.flatnonzero(reachable)
         if live.size == 0:
             return
         limit = hits.range_m
@@ -1256,26 +1468,33 @@ class Scene:
             limit = np.minimum(limit, batch.max_range)
         everywhere = (cells.a0 == 0) & (cells.a1 == AZ_BINS - 1) & (cells.e0 == 0) & (cells.e1 == EL_BINS - 1)
         around, rest = live[everywhere[live]], live[~everywhere[live]]
-        ray = label = np.empty(0, dtype=np.int64)
+        rays, labels, os_, ds = [], [], [], []
         if rest.size:  # rays of the objects' cells, via the cell-sorted order
             batch.sort_by_cell(limit, float(cells.near_m[rest].min()))
             ray, label = self._pairs_in_cells(batch, *cells.runs(rest))
-            best = np.take(limit, ray)
-            keep = best > np.take(cells.near_m, label)
-            ray, label, best = ray[keep], label[keep], best[keep]
-            keep = _pairs_reach_spheres(batch, ray, np.take(centres.T, label, axis=1), np.take(radii, label), best)
+            keep = np.take(limit, ray) > np.take(cells.near_m, label)
             ray, label = ray[keep], label[keep]
-        if around.size:
-            # Objects seen in every direction (e.g. the ship carrying the sensor):
-            # their rays in ray order (runs of equal times share one pose); a
-            # sphere test would filter next to nothing.
-            blocks = {int(k): np.flatnonzero(limit > cells.near_m[k]) for k in around}
-            ray, label = _insert_blocks(ray, label, blocks, len(self._movers))
-        if ray.size == 0:
-            return
-        bounds = np.searchsorted(label, np.arange(len(self._movers) + 1))
-        present = np.flatnonzero(bounds[1:] > bounds[:-1]).tolist()
-        self._merge_moving(hits, batch, self._cast_pairs(batch, hits, ray, label, bounds, present))
+            o, d = _gather_columns(batch.origins, ray), _gather_columns(batch.directions, ray)
+            keep = np.flatnonzero(
+                _pairs_reach_spheres(o, d, np.take(centres.T, label, axis=1), np.take(radii, label), np.take(limit, ray))
+            )
+            if keep.size < ray.size:
+                ray, label, o, d = ray[keep], label[keep], o[:, keep], d[:, keep]
+            rays.append(ray), labels.append(label), os_.append(o), ds.append(d)
+        for k in around.tolist():
+            # An object seen in every direction (e.g. the ship carrying the sensor, when
+            # no carrier is given): its rays in ray order (runs of equal times share one
+            # pose); a sphere test would filter next to nothing.
+            ray = np.flatnonzero(limit > cells.near_m[k])
+            rays.append(ray), labels.append(np.full(ray.size, k))
+            os_.append(_gather_columns(batch.origins, ray)), ds.append(_gather_columns(batch.directions, ray))
+        if len(rays) > 1:
+            ray, label = np.concatenate(rays), np.concatenate(labels)
+            o, d = np.concatenate(os_, axis=1), np.concatenate(ds, axis=1)
+        else:
+            ray, label, o, d = rays[0], labels[0], os_[0], ds[0]
+        if ray.size:
+            self._merge_moving(hits, self._cast_pairs(batch, hits, ray, label, o, d))
 
     @staticmethod
     def _pairs_in_cells(
@@ -1309,24 +1528,16 @@ class Scene:
         return batch.order[pos], np.repeat(label[row], length)
 
     def _cast_pairs(
-        self,
-        batch: _Batch,
-        hits: Hits,
-        ray: np.ndarray,
-        label: np.ndarray,
-        bounds: np.ndarray,
-        present: list[int],
+        self, batch: _Batch, hits: Hits, ray: np.ndarray, label: np.ndarray, o: np.ndarray, d: np.ndarray
     ) -> dict[str, np.ndarray] | None:
-        """Cast (ray, object) pairs at the objects' poses at the rays' times.
+        """Cast (ray, object) pairs at the objects' poses at the rays' times (one Embree call).
 
         Parameters
         ----------
         ray, label : (P,) int
-            Pairs, grouped by label; pairs of object ``k`` are ``bounds[k]:bounds[k+1]``.
-        bounds : (K + 1,) int
-            Group boundaries.
-        present : list of int
-            Objects with at least one pair.
+            Pairs (consecutive pairs of one object and one time share a pose).
+        o, d : (3, P) float64
+            World origin (metres) and unit direction of each pair's ray.
 
         Returns
         -------
@@ -1334,69 +1545,85 @@ class Scene:
             For the pairs that hit their object nearer than the ray's current best:
             ``ray``, ``label``, ``t`` (range, m), ``prim``, ``normal`` (world, (M, 3)).
         """
-        # Consecutive pairs of one object often share an instant (the rays of a
-        # LiDAR firing, of a radar spoke): one pose per run of equal times.
+        # Consecutive pairs of one object may share an instant (the rays of a LiDAR
+        # firing or a radar spoke in ray order): one pose per run of equal times,
+        # when that saves much; otherwise one pose per pair.
         times = np.take(batch.times, ray)
         new = np.empty(ray.size, dtype=bool)
         new[0] = True
         np.not_equal(times[1:], times[:-1], out=new[1:])
         new[1:] |= label[1:] != label[:-1]
         first = np.flatnonzero(new)  # first pair of each instant
-        u_bounds = np.searchsorted(first, bounds)
-        poses = [self._movers[k].obj.motion.poses(times[first[u_bounds[k] : u_bounds[k + 1]]]) for k in present]
-        pose = Poses(
-            np.concatenate([p.position_m for p in poses]),
-            np.concatenate([p.yaw_rad for p in poses]),
-            np.concatenate([p.pitch_rad for p in poses]),
-            np.concatenate([p.roll_rad for p in poses]),
-        )
-        rot = pose.rotation()  # (U, 3, 3) body -> world, one per instant
-        position = pose.position_m
-        if first.size < ray.size:  # expand instants to pairs
+        if 2 * first.size > ray.size:
+            first, instant = None, None
+            position, yaw, pitch, roll = self._bank.poses(label, times)
+        else:
             instant = np.cumsum(new) - 1
-            rot = np.take(rot, instant, axis=0)
-            position = np.take(position, instant, axis=0)
-        d = np.take(batch.directions, ray, axis=0)
-        w = np.take(batch.origins, ray, axis=0)
-        w -= position
-        rays64 = np.empty((ray.size, 2, 3), dtype=np.float64)
-        np.einsum("nji,nj->ni", rot, w, out=rays64[:, 0])
-        np.einsum("nji,nj->ni", rot, d, out=rays64[:, 1])
+            position, yaw, pitch, roll = self._bank.poses(label[first], times[first])
+            position = position[:, instant]
+        planar = pitch is None
+        if planar:  # yaw only: R = Rz(yaw)
+            rot = np.stack([np.cos(yaw), np.sin(yaw)])  # (2, U)
+        else:
+            rot = rotation_matrices(yaw, pitch, roll).reshape(-1, 9).T  # (9, U): row 3 i + j = R[i, j]
+        if instant is None:
+            instant = np.arange(ray.size)
+            r = rot
+        else:
+            r = rot[:, instant]
+        w = o - position
+        body_o, body_d = np.empty((3, ray.size)), np.empty((3, ray.size))
+        for src, dst in ((w, body_o), (d, body_d)):  # R^T v
+            if planar:
+                c, s = r
+                dst[0] = c * src[0] + s * src[1]
+                dst[1] = c * src[1] - s * src[0]
+                dst[2] = src[2]
+            else:
+                for i in range(3):
+                    dst[i] = r[i] * src[0] + r[3 + i] * src[1] + r[6 + i] * src[2]
         lo = np.take(self._mover_box_lo, label, axis=1)
         hi = np.take(self._mover_box_hi, label, axis=1)
-        inside = np.flatnonzero(_pairs_hit_boxes(rays64, lo, hi))
+        inside = np.flatnonzero(_pairs_hit_boxes(body_o, body_d, lo, hi))
         if inside.size == 0:
             return None
-        ray, label, rot, d = ray[inside], label[inside], rot[inside], d[inside]
-        body = rays64[inside]
-        # one Open3D call for all objects (the atlas): each ray starts where it enters its
-        # object's bounding sphere, moved into the object's atlas cell
-        o_b, d_b = body[:, 0], body[:, 1]
-        b = np.einsum("ni,ni->n", o_b, d_b)
-        c = np.einsum("ni,ni->n", o_b, o_b) - np.take(self._mover_radius, label) ** 2
-        t_entry = np.maximum(0.0, -b - np.sqrt(np.maximum(b * b - c, 0.0)))
+        if inside.size < ray.size:
+            ray, label, instant = ray[inside], label[inside], instant[inside]
+            body_o, body_d, d = body_o[:, inside], body_d[:, inside], d[:, inside]
+        # One Open3D call for all objects (the atlas): each ray starts where it enters
+        # its object's bounding sphere (float64), moved into the object's atlas cell.
+        b = np.einsum("ij,ij->j", body_o, body_d)
+        c = np.einsum("ij,ij->j", body_o, body_o) - np.take(self._mover_radius2, label)
+        disc = b * b - c
+        np.maximum(disc, 0.0, out=disc)
+        np.sqrt(disc, out=disc)
+        t_entry = -b - disc
+        np.maximum(t_entry, 0.0, out=t_entry)
         shifted = np.empty((ray.size, 6), dtype=np.float32)
-        shifted[:, :3] = o_b + t_entry[:, None] * d_b + np.take(self._atlas_offset, label, axis=0)
-        shifted[:, 3:] = d_b
+        shifted[:, :3] = (body_o + t_entry * body_d + np.take(self._atlas_offset, label, axis=1)).T
+        shifted[:, 3:] = body_d.T
         res = self._atlas.cast_rays(o3d.core.Tensor.from_numpy(shifted), nthreads=self.nthreads)
-        own = res["geometry_ids"].numpy().view(np.int32) == label
-        t = np.where(own, t_entry + res["t_hit"].numpy(), np.inf)
-        prim_all = res["primitive_ids"].numpy().view(np.int32)
-        normal_all = res["primitive_normals"].numpy()
-        better = t < np.take(hits.range_m, ray)
+        own = res["geometry_ids"].numpy().view(np.int32) == label  # another cell's object is never nearer
+        t = t_entry + res["t_hit"].numpy()
+        better = own & (t < np.take(hits.range_m, ray))
         if batch.max_range is not None:
             better &= t <= (np.take(batch.max_range, ray) if batch.max_range.ndim else float(batch.max_range))
         sel = np.flatnonzero(better)
         if sel.size == 0:
             return None
-        normal = normal_all[sel].astype(np.float64)
-        n_world = np.einsum("nij,nj->ni", rot[sel], normal)
-        flip = np.einsum("ni,ni->n", n_world, d[sel]) > 0
+        n_b = res["primitive_normals"].numpy()[sel].T.astype(np.float64)  # (3, S) body frame
+        r = rot[:, instant[sel]]
+        if planar:  # R n
+            c, s = r
+            n_world = np.stack([c * n_b[0] - s * n_b[1], s * n_b[0] + c * n_b[1], n_b[2]], axis=1)
+        else:
+            n_world = np.stack([r[3 * i] * n_b[0] + r[3 * i + 1] * n_b[1] + r[3 * i + 2] * n_b[2] for i in range(3)], axis=1)
+        flip = np.einsum("ni,in->n", n_world, d[:, sel]) > 0
         n_world[flip] *= -1.0
-        prim = prim_all[sel]
-        return {"ray": ray[sel], "label": label[sel], "t": t[sel].astype(np.float64), "prim": prim, "normal": n_world}
+        prim = res["primitive_ids"].numpy().view(np.int32)[sel]
+        return {"ray": ray[sel], "label": label[sel], "t": t[sel], "prim": prim, "normal": n_world}
 
-    def _merge_moving(self, hits: Hits, batch: _Batch, found: dict[str, np.ndarray] | None) -> None:
+    def _merge_moving(self, hits: Hits, found: dict[str, np.ndarray] | None) -> None:
         """Write the nearest moving-object hit of each ray into ``hits`` (in place)."""
         if found is None:
             return

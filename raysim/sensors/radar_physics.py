@@ -1,0 +1,267 @@
+"""Marine X-band radar physics: pure, vectorised functions (no rendering, no I/O).
+
+Every figure comes from /work/shared/REFERENCE.md section 3 (cited by item number as
+"REF 3.n") unless marked "(unverified)": those are engineering defaults, kept as named
+parameters so that a measured value can replace them.
+
+Units: powers are linear unless the name ends in ``_db``; angles in degrees where the
+name says ``_deg``, radians otherwise; ranges in metres.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.special import gammaincinv, ndtr
+
+# ------------------------------------------------------------------ constants
+
+C_MPS = 299_792_458.0  # speed of light
+FREQUENCY_GHZ = 9.41  # X band, REF 3 table (lambda = 3.19 cm)
+EARTH_RADIUS_M = 6_371_000.0  # mean earth radius
+EFFECTIVE_EARTH_FACTOR = 4.0 / 3.0  # standard refraction, REF 3.4 (re = 8495 km)
+EFFECTIVE_EARTH_RADIUS_M = EFFECTIVE_EARTH_FACTOR * EARTH_RADIUS_M
+KT0_DBM_PER_HZ = -174.0  # thermal noise density at 290 K, REF 3.1
+G_MPS2 = 9.81  # gravity, for the clutter texture correlation length (REF 3.8)
+
+# Radar equation example values, REF 3.1 (a Broadband 3G/4G class FMCW radar)
+PT_W = 0.1  # transmit power
+ANTENNA_GAIN_DBI = 23.0  # one way
+SWEEP_S = 1e-3  # coherent FMCW sweep per spoke
+NOISE_FIGURE_DB = 5.0
+LOSSES_DB = 6.0
+
+# Antenna, REF 3 table / 3.2 (unverified for the 18 in dome)
+BEAM_AZ_DEG = 5.2  # -3 dB horizontal width
+BEAM_EL_DEG = 25.0  # -3 dB vertical width
+RANGE_RESOLUTION_M = 2.5  # c/(2B), REF 3 table / 3.3 ("about 2-3 m")
+
+# NRL sea clutter coefficients (Gregers-Hansen & Mital 2012; REF 3.7): c1..c5
+NRL_COEFFS = {
+    "HH": (-73.0, 20.781, 7.351, 25.65, 0.0054),
+    "VV": (-50.796, 25.93, 0.7093, 21.588, 0.00211),
+}
+# Ward et al. K-distribution shape (REF 3.8): polarisation constant and clamp
+WARD_K_POL = {"VV": 1.39, "HH": 2.09}
+NU_MIN, NU_MAX = 0.1, 20.0  # REF 3.8 "clamp nu to about [0.1, 20]"
+# Wind speed W per Douglas sea state 0..6 for the texture correlation length (REF 3.8 gives SS1..6;
+# SS0 takes the SS1 value, an assumption)
+TEXTURE_WIND_MPS = (2.5, 2.5, 4.5, 6.0, 8.5, 11.0, 14.0)
+
+# Rain, REF 3.9 (ITU-R P.838 at 9.41 GHz, one way; Marshall-Palmer Z-R)
+RAIN_RATE_TABLE_MM_PER_H = np.array([1.0, 4.0, 16.0, 50.0])
+RAIN_ATTENUATION_TABLE_DB_PER_KM = np.array([0.0093, 0.056, 0.33, 1.44])
+WATER_K2 = 0.93  # |K|^2 of water
+Z_R_A, Z_R_B = 200.0, 1.6  # Z = a R^b, mm^6/m^3
+
+
+def wavelength_m(f_ghz: float = FREQUENCY_GHZ) -> float:
+    """Wavelength, m."""
+    return C_MPS / (f_ghz * 1e9)
+
+
+def db(x):
+    """10 log10 of a power ratio (-inf for 0)."""
+    with np.errstate(divide="ignore"):
+        return 10.0 * np.log10(x)
+
+
+def undb(x_db):
+    """Power ratio of a dB value."""
+    return np.power(10.0, np.asarray(x_db, dtype=float) / 10.0)
+
+
+# ------------------------------------------------------------------ geometry (REF 3.4)
+
+
+def horizon_m(height_m, re_m: float = EFFECTIVE_EARTH_RADIUS_M):
+    """Distance to the radar horizon of a point at ``height_m``: sqrt(2 re h)."""
+    return np.sqrt(2.0 * re_m * np.maximum(np.asarray(height_m, dtype=float), 0.0))
+
+
+def grazing_angle_deg(height_m, range_m, re_m: float = EFFECTIVE_EARTH_RADIUS_M):
+    """Grazing angle at the sea at slant range ``range_m`` seen from ``height_m`` (4/3 earth).
+
+    ``psi = asin(h/r + h^2/(2 re r) - r/(2 re))``; NaN beyond the horizon (argument <= 0);
+    90 deg inside the antenna height.
+    """
+    h = np.asarray(height_m, dtype=float)
+    r = np.maximum(np.asarray(range_m, dtype=float), 1e-6)
+    arg = h / r + h * h / (2.0 * re_m * r) - r / (2.0 * re_m)
+    psi = np.degrees(np.arcsin(np.clip(arg, -1.0, 1.0)))
+    return np.where(arg > 0.0, psi, np.nan)
+
+
+def hidden_height_m(distance_m, antenna_height_m, re_m: float = EFFECTIVE_EARTH_RADIUS_M):
+    """Height below which a point at horizontal ``distance_m`` is below the radar horizon.
+
+    ``(d - sqrt(2 re ha))^2 / (2 re)`` beyond the antenna's horizon, 0 before it (REF 3.4).
+    """
+    beyond = np.maximum(np.asarray(distance_m, dtype=float) - horizon_m(antenna_height_m, re_m), 0.0)
+    return beyond * beyond / (2.0 * re_m)
+
+
+# ------------------------------------------------------------------ radar equation (REF 3.1)
+
+
+def snr(sigma_m2, range_m, pt_w: float = PT_W, gain_dbi: float = ANTENNA_GAIN_DBI, f_ghz: float = FREQUENCY_GHZ,
+        sweep_s: float = SWEEP_S, noise_figure_db: float = NOISE_FIGURE_DB, losses_db: float = LOSSES_DB,
+        kt0_dbm_per_hz: float = KT0_DBM_PER_HZ, propagation_f4=1.0):
+    """Single-sweep FMCW SNR (linear): ``Pt G^2 lambda^2 sigma T F^4 / ((4 pi)^3 R^4 kT0 Fn L)``."""
+    lam = wavelength_m(f_ghz)
+    kt0_w_per_hz = 10.0 ** ((kt0_dbm_per_hz - 30.0) / 10.0)
+    const = pt_w * undb(2.0 * gain_dbi) * lam * lam * sweep_s / ((4.0 * math.pi) ** 3 * kt0_w_per_hz
+                                                                 * undb(noise_figure_db) * undb(losses_db))
+    r = np.maximum(np.asarray(range_m, dtype=float), 1e-3)
+    return const * np.asarray(sigma_m2, dtype=float) * propagation_f4 / r**4
+
+
+def snr_db(sigma_m2, range_m, **kw):
+    """:func:`snr` in dB."""
+    return db(snr(sigma_m2, range_m, **kw))
+
+
+# ------------------------------------------------------------------ antenna (REF 3.2)
+
+
+def two_way_gain(theta_deg, width_3db_deg: float = BEAM_AZ_DEG):
+    """Two-way power gain (peak 1) of a Gaussian beam: ``exp(-4 ln2 theta^2/theta3^2)`` squared."""
+    t = np.asarray(theta_deg, dtype=float)
+    return np.exp(-8.0 * math.log(2.0) * t * t / (width_3db_deg * width_3db_deg))
+
+
+def two_way_equivalent_width_rad(width_3db_deg: float) -> float:
+    """Integral of :func:`two_way_gain` over angle, rad: ``theta3 sqrt(pi / (8 ln 2))`` (0.753 theta3)."""
+    return math.radians(width_3db_deg) * math.sqrt(math.pi / (8.0 * math.log(2.0)))
+
+
+# ------------------------------------------------------------------ sea clutter (REF 3.7, 3.8)
+
+
+def nrl_sigma0_db(psi_deg, f_ghz: float = FREQUENCY_GHZ, sea_state=2, pol: str = "HH"):
+    """NRL mean sea reflectivity sigma0 (dB m^2/m^2), Gregers-Hansen & Mital 2012.
+
+    ``c1 + c2 log10(sin psi) + (27.5 + c3 psi) log10(f)/(1 + 0.95 psi)
+    + c4 (SS + 1)^(1/(2 + 0.085 psi + 0.033 SS)) + c5 psi^2`` (psi deg, f GHz, Douglas SS).
+    Valid for psi 0.1..60 deg; used below 0.1 deg as is (it keeps falling with sin psi).
+    """
+    c1, c2, c3, c4, c5 = NRL_COEFFS[pol]
+    psi = np.asarray(psi_deg, dtype=float)
+    ss = np.asarray(sea_state, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return (c1 + c2 * np.log10(np.sin(np.radians(psi))) + (27.5 + c3 * psi) * math.log10(f_ghz) / (1.0 + 0.95 * psi)
+                + c4 * (ss + 1.0) ** (1.0 / (2.0 + 0.085 * psi + 0.033 * ss)) + c5 * psi * psi)
+
+
+def clutter_cell_area_m2(range_m, psi_deg, beam_width_rad: float, range_cell_m: float):
+    """Sea area of a resolution cell at low grazing: ``R theta dR sec(psi)`` (REF 3.7)."""
+    return np.asarray(range_m, dtype=float) * beam_width_rad * range_cell_m / np.cos(np.radians(psi_deg))
+
+
+def ward_shape_nu(psi_deg, cell_area_m2, pol: str = "HH", theta_swell_deg=0.0, nu_min: float = NU_MIN,
+                  nu_max: float = NU_MAX):
+    """K-distribution shape: ``log10 nu = 2/3 log10 psi + 5/8 log10 Ac - k_pol - cos(2 theta_sw)/3``, clamped."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        log_nu = ((2.0 / 3.0) * np.log10(np.asarray(psi_deg, dtype=float)) + 0.625 * np.log10(cell_area_m2)
+                  - WARD_K_POL[pol] - np.cos(np.radians(2.0 * np.asarray(theta_swell_deg, dtype=float))) / 3.0)
+    return np.clip(np.nan_to_num(10.0 ** log_nu, nan=nu_min), nu_min, nu_max)
+
+
+def texture_correlation_length_m(sea_state: int, aspect_deg=0.0) -> float:
+    """Range correlation length of the texture: ``(pi/2)(W^2/g) sqrt(3 cos^2(Aw) + 1)`` (REF 3.8)."""
+    w = TEXTURE_WIND_MPS[int(np.clip(sea_state, 0, 6))]
+    return float(np.mean((math.pi / 2.0) * (w * w / G_MPS2) * np.sqrt(3.0 * np.cos(np.radians(aspect_deg)) ** 2 + 1.0)))
+
+
+class GammaQuantiles:
+    """Fast Gamma(nu, mean 1) quantiles of standard-normal values, by table lookup.
+
+    ``scipy.special.gammaincinv`` costs about 0.7 us a value; a revolution has 2 M clutter
+    cells. The table holds ``nu_steps`` log-spaced shapes in [NU_MIN, NU_MAX] (nearest is
+    used) and ``z_steps`` normal quantiles in [-z_max, z_max] (linear interpolation).
+    """
+
+    def __init__(self, nu_steps: int = 64, z_steps: int = 1201, z_max: float = 6.0):
+        self.log_nu = np.linspace(math.log(NU_MIN), math.log(NU_MAX), nu_steps)
+        self.z = np.linspace(-z_max, z_max, z_steps)
+        nu = np.exp(self.log_nu)[:, None]
+        u = np.clip(ndtr(self.z)[None, :], 1e-300, 1.0 - 1e-16)
+        self.table = (gammaincinv(nu, u) / nu).astype(np.float64)
+        self.dz = self.z[1] - self.z[0]
+
+    def __call__(self, z: np.ndarray, nu: np.ndarray) -> np.ndarray:
+        k = np.rint((np.log(np.clip(nu, NU_MIN, NU_MAX)) - self.log_nu[0]) / (self.log_nu[1] - self.log_nu[0])).astype(np.intp)
+        pos = np.clip((z - self.z[0]) / self.dz, 0.0, self.z.size - 1.000001)
+        j = pos.astype(np.intp)
+        frac = pos - j
+        flat = k * self.z.size + j
+        t = self.table.reshape(-1)
+        return t[flat] * (1.0 - frac) + t[flat + 1] * frac
+
+
+# ------------------------------------------------------------------ rain (REF 3.9)
+
+
+def rain_attenuation_db_per_km(rain_mm_per_h):
+    """One-way specific attenuation at 9.41 GHz, dB/km: the ITU-R P.838 values, log-log interpolated.
+
+    Outside 1..50 mm/h the end segments' power laws are extended; 0 mm/h gives 0.
+    """
+    r = np.asarray(rain_mm_per_h, dtype=float)
+    lr, la = np.log(RAIN_RATE_TABLE_MM_PER_H), np.log(RAIN_ATTENUATION_TABLE_DB_PER_KM)
+    x = np.log(np.maximum(r, 1e-12))
+    slope_lo = (la[1] - la[0]) / (lr[1] - lr[0])
+    slope_hi = (la[-1] - la[-2]) / (lr[-1] - lr[-2])
+    y = np.interp(x, lr, la)
+    y = np.where(x < lr[0], la[0] + slope_lo * (x - lr[0]), y)
+    y = np.where(x > lr[-1], la[-1] + slope_hi * (x - lr[-1]), y)
+    return np.where(r > 0, np.exp(y), 0.0)
+
+
+def rain_reflectivity_z(rain_mm_per_h):
+    """Radar reflectivity factor Z = 200 R^1.6, mm^6/m^3 (Marshall-Palmer)."""
+    return Z_R_A * np.power(np.maximum(np.asarray(rain_mm_per_h, dtype=float), 0.0), Z_R_B)
+
+
+def rain_eta_m2_per_m3(rain_mm_per_h, f_ghz: float = FREQUENCY_GHZ, k2: float = WATER_K2):
+    """Rain volume backscatter ``eta = pi^5 |K|^2 Z / lambda^4``, m^2/m^3 (Z converted to m^6/m^3)."""
+    lam = wavelength_m(f_ghz)
+    return math.pi**5 * k2 * rain_reflectivity_z(rain_mm_per_h) * 1e-18 / lam**4
+
+
+# ------------------------------------------------------------------ targets (REF 3.6)
+
+
+def facet_sigma_m2(reflectivity_db, cos_incidence, specular_exponent, range_m, d_az_rad, d_el_rad,
+                   diffuse_gain: float, specular_gain: float):
+    """RCS of the surface patch one ray stands for.
+
+    The ray's footprint is ``A = R^2 d_az d_el / cos(theta)``; its backscatter
+    ``sigma = rho A cos(theta) (D cos(theta) + S cos^n(theta))`` with rho the material's power
+    reflectivity (re. metal), D a diffuse and S a specular gain (engineering defaults, unverified).
+    """
+    c = np.clip(np.asarray(cos_incidence, dtype=float), 0.0, 1.0)
+    rho = undb(reflectivity_db)
+    projected = np.asarray(range_m, dtype=float) ** 2 * d_az_rad * d_el_rad
+    return rho * projected * (diffuse_gain * c + specular_gain * np.power(c, specular_exponent))
+
+
+# ------------------------------------------------------------------ receiver (REF 3.10)
+
+
+def stc_gain_db(range_m, a0_db: float, n: float, r0_m: float):
+    """Sensitivity time control: ``min(0, -A0 + 10 n log10(R/R0))`` dB (0 everywhere when A0 = 0)."""
+    if a0_db <= 0.0:
+        return np.zeros_like(np.asarray(range_m, dtype=float))
+    r = np.maximum(np.asarray(range_m, dtype=float), 1e-3)
+    return np.minimum(0.0, -a0_db + 10.0 * n * np.log10(r / r0_m))
+
+
+def quantise(power_db, floor_db: float, step_db: float, levels: int = 16) -> np.ndarray:
+    """4-bit video on FIXED absolute levels: ``clip(floor((P_dB - floor_dB)/step_dB), 0, 15)``.
+
+    Levels are relative to the receiver noise (P in dB re. noise), never to each spoke's maximum.
+    """
+    v = np.floor((np.asarray(power_db, dtype=float) - floor_db) / step_db)
+    return np.clip(np.nan_to_num(v, nan=0.0, neginf=0.0, posinf=levels - 1), 0, levels - 1).astype(np.uint8)
