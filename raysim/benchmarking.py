@@ -1,7 +1,8 @@
 """Measurements of the ray engine against raw Embree (used by ``benchmarks/ray_engine.py``).
 
-Every function returns plain dicts (JSON-ready); formatting lives in the
-script. Figures are medians of repeated runs, and every ratio compares two
+Every ``bench_*`` function returns plain dicts (JSON-ready);
+:func:`to_markdown` formats them and :func:`main` runs everything (the
+``benchmarks/ray_engine.py`` script and ``raysim bench`` call it). Figures are medians of repeated runs, and every ratio compares two
 measurements interleaved in the same loop of the same run, never against a
 figure from another machine or another run.
 
@@ -21,9 +22,11 @@ Scenes
 from __future__ import annotations
 
 import datetime as _dt
+import json
 import os
 import platform
 import time
+from pathlib import Path
 from typing import Callable
 
 import numpy as np
@@ -31,7 +34,7 @@ import open3d as o3d
 import trimesh
 
 from raysim.motion import ConstantVelocity, Stationary
-from raysim.scene import Scene, SceneObject, pack_rays
+from raysim.scene import Carrier, Scene, SceneObject, pack_rays
 
 HDL32E_ELEVATIONS_DEG = np.linspace(-30.67, 10.67, 32)
 """HDL-32E laser elevations (REFERENCE.md section 2), degrees."""
@@ -342,30 +345,47 @@ def bench_moving(
 
 
 def bench_own_ship(n_firings: int = 18000, reps: int = 5, duration_s: float = 0.1) -> dict:
-    """Cost of a moving object around the sensor (the ship carrying it).
+    """Cost of a moving object around the sensor (the ship carrying it), with and without ``carrier``.
 
-    Its swept sphere contains every ray origin, so every ray is a candidate and
-    needs its pose: the worst case of the moving-object path. Compares one
-    ship 50-1500 m away with the same scene plus a 12 m own ship (yawing,
-    5.1 k triangles) centred under the sensor; sea on.
+    Its swept sphere contains every ray origin, so in a plain cast every ray is a
+    candidate and needs its pose: the worst case of the moving-object path.
+    Compares one ship 50-1500 m away with the same scene plus a 12 m own ship
+    (yawing, 5.1 k triangles) centred under the sensor, cast plainly and with
+    :class:`raysim.scene.Carrier` (the rays in the own ship's body frame, as a
+    sensor on it has them; built outside the timed loop); sea on.
     """
     o, d, t = hdl32e_rays(n_firings, duration_s=duration_s)
     fleet = ship_objects(1, seed=3)
     v, f = ship_mesh(12.0, subdivisions=4)
     own = SceneObject(999, v, f, np.zeros(len(f), dtype=np.int16), ConstantVelocity((0, 0, 0), (0, 0, 0), 0.0, 0.05))
-    scenes = {"without": Scene(fleet, sea=True), "with": Scene(fleet + [own], sea=True)}
-    med = _interleaved_medians({k: (lambda s=s: s.cast(o, d, t)) for k, s in scenes.items()}, reps)
+    pose = own.motion.poses(t)
+    rot = pose.rotation()
+    carrier = Carrier(
+        999,
+        np.einsum("nji,nj->ni", rot, o - pose.position_m),
+        np.einsum("nji,nj->ni", rot, d),
+    )
+    without, with_own = Scene(fleet, sea=True), Scene(fleet + [own], sea=True)
+    fns = {
+        "without": lambda: without.cast(o, d, t),
+        "with": lambda: with_own.cast(o, d, t),
+        "carrier": lambda: with_own.cast(o, d, t, carrier=carrier),
+    }
+    med = _interleaved_medians(fns, reps)
     n = len(o)
+    plain, fast = with_own.cast(o, d, t), with_own.cast(o, d, t, carrier=carrier)
     return {
         "rays": n,
-        "own_ship_hit_fraction": float(np.mean(scenes["with"].cast(o, d, t).object_id == 999)),
+        "own_ship_hit_fraction": float(np.mean(plain.object_id == 999)),
+        "carrier_same_ids": bool(np.array_equal(plain.object_id, fast.object_id)),
         "ns_per_ray_without": 1e9 * med["without"] / n,
         "ns_per_ray_with": 1e9 * med["with"] / n,
+        "ns_per_ray_with_carrier": 1e9 * med["carrier"] / n,
     }
 
 
 def run_all(quick: bool = False) -> dict:
-    """All three measurements in one run (``quick``: fewer rays and repetitions)."""
+    """All measurements in one run (``quick``: fewer rays and repetitions)."""
     n_firings = 4000 if quick else 18000
     reps = 3 if quick else 7
     return {
@@ -379,3 +399,230 @@ def run_all(quick: bool = False) -> dict:
         "moving_one_revolution": bench_moving(n_firings=2170, reps=max(reps, 5)),
         "own_ship": bench_own_ship(n_firings=n_firings, reps=reps),
     }
+
+
+# --------------------------------------------------------------- reporting
+
+
+def key_figures(res: dict) -> dict[str, float]:
+    """The headline figures of one run (those the targets are about), by label."""
+    out: dict[str, float] = {}
+    if "static" in res:
+        out["(a) static sparse: fraction of raw"] = res["static"]["fraction_of_raw"]
+    if "dense" in res:
+        out["(a) static dense: fraction of raw"] = res["dense"]["fraction_of_raw"]
+    for r in res.get("triangles", []):
+        out[f"(b) {r['triangles']:,} triangles: fraction of raw"] = r["fraction_of_raw"]
+    labels = (
+        ("moving", "ships only"),
+        ("moving_with_icebergs", "ships + icebergs"),
+        ("moving_one_revolution", "ships only"),
+    )
+    for key, title in labels:
+        rows = res.get(key) or []
+        if len(rows) > 1:
+            last = rows[-1]
+            out[f"(c) {title}, {last['rays']:,} rays: cost per ray {last['moving_objects']} vs "
+                f"{rows[0]['moving_objects']} objects"] = last["cost_per_ray_vs_first"]
+    if "own_ship" in res:
+        ow = res["own_ship"]
+        out["own ship: ns/ray without it"] = ow["ns_per_ray_without"]
+        out["own ship: ns/ray with it, plain cast"] = ow["ns_per_ray_with"]
+        if "ns_per_ray_with_carrier" in ow:
+            out["own ship: ns/ray with it, carrier="] = ow["ns_per_ray_with_carrier"]
+    return out
+
+
+def _m(x: float) -> str:
+    """Millions, two decimals."""
+    return f"{x / 1e6:.2f}"
+
+
+def to_markdown(res: dict) -> str:
+    """The results of :func:`run_all` (or :func:`main`) as a markdown report.
+
+    Sections appear only for the measurements present in ``res`` (only
+    ``machine`` and ``quick`` are required). If ``res["runs"]`` holds the
+    :func:`key_figures` of several runs, a table of them (with their median)
+    comes first; the detailed tables are those of ``res`` itself.
+    """
+    m = res["machine"]
+    runs = res.get("runs") or []
+    flags = (" --quick" if res.get("quick") else "") + (f" --runs {len(runs)}" if len(runs) > 1 else "")
+    lines = [
+        "# Ray engine benchmark",
+        "",
+        f"Generated by `python benchmarks/ray_engine.py{flags}` (or `raysim bench`) on {m['date']}.",
+        "",
+        f"Machine: {m['nproc']} cores, {m['cpu']}; Python {m['python']}, numpy {m['numpy']}, "
+        f"Open3D {m['open3d']}, embreex {m['embreex']}, trimesh {m['trimesh']}.",
+        "",
+        "All figures are medians of repeated runs; each ratio compares measurements interleaved in the",
+        "same loop of this run. Raw = one Open3D `RaycastingScene.cast_rays` of a prebuilt float32",
+        "tensor of the same rays on the same static scene (the Scene's own structure), all threads.",
+        "Rays: HDL-32E pattern (32 lasers -30.67..+10.67 deg, azimuth step 0.1659 deg), 3 m above the sea.",
+    ]
+    if len(runs) > 1:
+        labels = list(runs[0])
+        lines += [
+            "",
+            f"## Headline figures of {len(runs)} complete runs (run-to-run noise)",
+            "",
+            "The detailed tables below are those of run 1.",
+            "",
+            "| figure | " + " | ".join(f"run {i + 1}" for i in range(len(runs))) + " | median |",
+            "|---|" + "---:|" * (len(runs) + 1),
+        ]
+        for label in labels:
+            values = [r.get(label, float("nan")) for r in runs]
+            lines.append(f"| {label} | " + " | ".join(f"{v:.2f}" for v in values) + f" | {float(np.median(values)):.2f} |")
+    if "static" in res:
+        st = res["static"]
+        lines += [
+            "",
+            "## (a) Static scene",
+            "",
+            f"{st['objects']} smooth icebergs (radius 15 m, 80-600 m away), {st['triangles']:,} triangles, "
+            f"{st['rays']:,} rays, {100 * st['hit_fraction']:.1f} % of rays hit; sea off.",
+            "",
+            "| engine | M rays/s | fraction of raw |",
+            "|---|---:|---:|",
+            f"| raw Open3D cast_rays (prebuilt tensor) | {_m(st['raw_o3d_rays_per_s'])} | 1.00 |",
+            f"| **Scene.cast** (culling on) | {_m(st['scene_rays_per_s'])} | **{st['fraction_of_raw']:.2f}** |",
+            f"| Scene.cast, static culling off (every ray cast) | {_m(st['scene_nocull_rays_per_s'])} "
+            f"| {st['nocull_fraction_of_raw']:.2f} |",
+        ]
+        if "raw_embreex_rays_per_s" in st:
+            lines.append(
+                f"| raw embreex EmbreeScene.run (1 thread, output=1) | {_m(st['raw_embreex_rays_per_s'])} "
+                f"| {st['raw_embreex_rays_per_s'] / st['raw_o3d_rays_per_s']:.2f} |"
+            )
+    if "dense" in res:
+        de = res["dense"]
+        lines += [
+            "",
+            f"Dense variant (same meshes 25-60 m away, {100 * de['hit_fraction']:.0f} % of rays hit): raw "
+            f"{_m(de['raw_o3d_rays_per_s'])} M rays/s, Scene.cast {_m(de['scene_rays_per_s'])} M rays/s, "
+            f"fraction **{de['fraction_of_raw']:.2f}**.",
+        ]
+    if res.get("triangles"):
+        lines += [
+            "",
+            "## (b) Scaling with triangles (static, sea off)",
+            "",
+            "| triangles | objects | rays hit % | raw M rays/s | Scene M rays/s | fraction of raw |",
+            "|---:|---:|---:|---:|---:|---:|",
+        ]
+        for r in res["triangles"]:
+            lines.append(
+                f"| {r['triangles']:,} | {r['objects']} | {100 * r['hit_fraction']:.1f} | {_m(r['raw_o3d_rays_per_s'])} | "
+                f"{_m(r['scene_rays_per_s'])} | {r['fraction_of_raw']:.2f} |"
+            )
+    variants = (
+        ("moving", "ships only"),
+        ("moving_with_icebergs", "ships + the 14 static icebergs of (a)"),
+        ("moving_one_revolution", "ships only, one 10 Hz revolution per batch"),
+    )
+    for key, title in variants:
+        if not res.get(key):
+            continue
+        rays = res[key][0]["rays"]
+        lines += [
+            "",
+            f"## (c) Scaling with moving objects: {title}, sea on",
+            "",
+            "Ships 10-80 m long (1.3 k or 5.1 k triangles), 50-1500 m away, constant velocity 0-10 m/s;",
+            f"{rays:,} rays per batch, times spread over 0.1 s; the k-object scene is the first k ships of one fleet.",
+            "",
+            "| moving objects | moving triangles | ship hits % | M rays/s | ns/ray | cost per ray vs 1 object |",
+            "|---:|---:|---:|---:|---:|---:|",
+        ]
+        for r in res[key]:
+            lines.append(
+                f"| {r['moving_objects']} | {r['triangles_moving']:,} | {100 * r['ship_hit_fraction']:.2f} | "
+                f"{_m(r['rays_per_s'])} | {r['ns_per_ray']:.1f} | {r['cost_per_ray_vs_first']:.2f} |"
+            )
+    if "own_ship" in res:
+        ow = res["own_ship"]
+        base = ow["ns_per_ray_without"]
+        lines += [
+            "",
+            "## Own ship: a moving object around the sensor",
+            "",
+            f"One ship far away, then the same plus a yawing 12 m own ship (5.1 k triangles) centred under the "
+            f"sensor ({ow['rays']:,} rays, {100 * ow['own_ship_hit_fraction']:.1f} % hit the own ship); sea on.",
+            "",
+            "| case | ns/ray | vs without own ship |",
+            "|---|---:|---:|",
+            f"| without own ship | {base:.1f} | 1.00 |",
+            f"| with own ship, plain `Scene.cast` (every ray a candidate: pose + transform) | "
+            f"{ow['ns_per_ray_with']:.1f} | {ow['ns_per_ray_with'] / base:.2f} |",
+        ]
+        if "ns_per_ray_with_carrier" in ow:
+            lines.append(
+                f"| with own ship, `Scene.cast(..., carrier=Carrier(...))` (body-frame rays, no pose) | "
+                f"{ow['ns_per_ray_with_carrier']:.1f} | {ow['ns_per_ray_with_carrier'] / base:.2f} |"
+            )
+    lines += [
+        "",
+        "## Notes",
+        "",
+        "- Static culling sends to Embree only the rays whose direction cell can meet a static",
+        "  object's bounding sphere before the sea or the range limit, so on sparse scenes Scene.cast",
+        "  can beat one raw cast of all rays. 'Culling off' shows the bare per-ray overhead (packing",
+        "  float64 rays into float32, converting Embree's answers); a sensor surrounded by geometry",
+        "  takes that path automatically (the dense variant).",
+        "- All moving objects share ONE Embree scene (the atlas: each body-frame mesh in its own",
+        "  cell, rays started at their object's bounding sphere), so a batch makes one Embree call",
+        "  whatever the number of objects, and poses are evaluated for all objects in one vectorised",
+        "  pass per motion kind. What grows with the number of objects is the work per candidate",
+        "  (ray, object) pair (pose, body transform, slab test, Embree), i.e. with the objects the",
+        "  rays can actually reach.",
+        "- The own ship's sensors pass their body-frame rays (`carrier=`): the own ship is then cast",
+        "  without any pose evaluation or culling (one extra Embree call on its mesh alone).",
+        "- Timings on this shared 2-vCPU VM vary noticeably between runs; compare ratios within a run.",
+        "",
+        "Targets: (a) >= 0.80 of raw; (c) cost per ray at 100 objects <= 2x that at 1 object.",
+        "",
+    ]
+    return "\n".join(lines)
+
+
+def _write_atomic(path: Path, text: str) -> None:
+    """Write ``text`` to ``path`` through a temporary name and a rename."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(text, encoding="utf-8")
+    os.replace(tmp, path)
+
+
+def main(quick: bool = False, json_path: Path | None = None, out_path: Path | None = None, runs: int = 1) -> int:
+    """Run every measurement, print the markdown report, write it and the JSON when asked.
+
+    Parameters
+    ----------
+    quick : bool
+        Fewer rays and repetitions.
+    json_path : Path, optional
+        Also write the raw results (of run 1, plus every run's key figures) as JSON.
+    out_path : Path, optional
+        Also write the markdown report there.
+    runs : int
+        Complete runs; with more than one, the report starts with each run's headline
+        figures and their median (the noise between runs).
+
+    Returns
+    -------
+    int
+        0 (exit status).
+    """
+    results = [run_all(quick=quick) for _ in range(max(1, int(runs)))]
+    res = dict(results[0])
+    res["runs"] = [key_figures(r) for r in results]
+    text = to_markdown(res)
+    if out_path is not None:
+        _write_atomic(Path(out_path), text)
+    if json_path is not None:
+        _write_atomic(Path(json_path), json.dumps(res, indent=2) + "\n")
+    print(text)
+    return 0

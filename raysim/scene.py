@@ -15,16 +15,43 @@ Static objects (motion :class:`raysim.motion.Stationary`)
     origins are shifted by the same offset, in float64, before casting.
 Moving objects
     All moving objects share ONE ``RaycastingScene``, the *atlas*, built once in
-    ``__init__`` and never rebuilt: each object's body-frame mesh sits in its own
-    cell of a compact grid (cells farther apart than any two bounding spheres).
-    For a batch, candidate rays are culled (below), each object's pose is
-    evaluated at each candidate ray's own time, the rays are moved into the body
-    frame (``o' = R^T (o - p)``, ``d' = R^T d``), started at the entry of the
-    object's bounding sphere and shifted into its cell, and ALL objects' rays are
-    cast in one call; a hit counts when it is on the ray's own object (nothing in
-    another cell can come first), and hits nearer than the current best replace
-    it (range = sphere entry + Embree's distance, normals rotated back to the
-    world frame). One Embree call per batch whatever the number of objects.
+    ``__init__`` and never rebuilt: each object's body-frame mesh (its own copy,
+    even where objects share a mesh) sits in its own cell of a square grid in
+    the x-z plane, the cells ``2 r_max + 10 m`` apart (``r_max``: the largest
+    bounding radius of a body about its origin), so the cells' spheres are
+    disjoint and coordinates stay within a few kilometres (float32 keeps
+    sub-millimetre precision). For a batch, candidate (ray, object) pairs are
+    culled (below), each object's pose is evaluated at each candidate ray's own
+    time, the rays are moved into the body frame (``o' = R^T (o - p)``,
+    ``d' = R^T d``, float64), their origins are moved forward to the entry of
+    the body's bounding sphere (``t_entry = max(0, entry)``) and shifted into
+    the body's cell, and ALL objects' rays are cast in ONE call. A hit counts
+    only if its geometry is the ray's own object: a ray that misses its object
+    may go on into other cells, but since it starts at its own sphere and the
+    spheres are disjoint, any hit on its own object comes first. The range is
+    ``t_entry + t_hit`` in float64; normals are rotated back to the world frame;
+    hits nearer than the current best replace it. The grid is a vertical plane
+    because sensors see bodies along near-horizontal rays, which then leave the
+    plane instead of crossing other cells (Embree time).
+Poses
+    A :class:`_PoseBank` packs the motions of known kinds (exactly
+    :class:`~raysim.motion.ConstantVelocity`, :class:`~raysim.motion.SampledTrack`,
+    :class:`~raysim.motion.ShipMotion` of a ``SampledTrack`` with or without
+    :class:`~raysim.motion.WaveMotion`) into parameter tables once, and evaluates
+    the poses of all pairs of a kind in one vectorised pass, with the motions'
+    own arithmetic (the same numbers); other motions are asked object by
+    object. Objects with neither pitch nor roll take a yaw-only rotation.
+The carrier (optional, per batch)
+    A sensor on the own ship knows its rays in the ship's body frame. Passed as
+    ``Scene.cast(..., carrier=Carrier(object_id, origins_body_m,
+    directions_body[, rotation]))``, these rays are cast as they are, with one
+    extra Open3D call on a scene holding only the carrier's body-frame mesh
+    (built on first use): no pose, no culling, no transform for that object
+    (whose sphere holds every ray origin, so it would otherwise make every ray
+    a candidate). Normals of carrier hits are rotated to the world frame with
+    ``rotation`` if given, else with the carrier's pose at those hits' times.
+    The carrier is cast before the other moving objects, so rays stopped by
+    the own deck drop out of their culling.
 The sea
     The flat analytic plane ``z = 0`` (:func:`intersect_sea`).
 
@@ -59,14 +86,20 @@ uses.
   uint16 is a radix sort). For all objects at once (vectorised over
   (ray, object) pairs): the rays of each object's cells (contiguous runs of
   the sorted order; two runs when the azimuth interval wraps at +-pi), minus
-  those whose current best hit (sea, static scene, ``max_range_m``) is nearer
-  than the sphere can be, minus those failing an exact ray/sphere test. The
-  survivors get their object's pose at their own time (one ``poses`` call per
-  object, one ``Poses.rotation()`` for all), are moved into the body frame,
-  pass a slab test against the body's bounding box, and are cast with one
-  Open3D call per object; the nearest hit per ray wins. The cost per ray thus
-  grows with the number of objects a ray can actually reach, plus a fixed
-  cost of some tens of microseconds per object and batch.
+  those whose current best hit (sea, static scene, carrier, ``max_range_m``)
+  is nearer than the sphere can be, minus those failing an exact ray/sphere
+  test (on origins and directions gathered once, as columns). An object seen
+  in every direction (its sphere holds the origins: the own ship when no
+  carrier is given) takes all rays that can still get a hit, in ray order.
+  The survivors get their poses (the pose bank; one pose per run of pairs
+  sharing an instant when that halves the work), are moved into the body
+  frame, pass a slab test against the body's bounding box, and go to the
+  atlas in one Open3D call; the nearest hit per ray wins. Swept spheres are
+  computed for all objects in one pass too. The cost per ray thus grows with
+  the number of (ray, object) pairs, i.e. with the objects the rays can
+  actually reach. No Python loop runs over the objects (except over those
+  seen in every direction and those with motions of unknown kinds); what is
+  left per object and batch is a few table entries of vectorised work.
 
 Per-ray numpy work is kept to a few contiguous passes; hit bookkeeping
 touches hits only. Open3D holds the GIL while casting, so numpy work cannot
@@ -534,13 +567,13 @@ class _PoseBank:
         self.single_kind = k > 0 and bool(np.all(self.kind == self.kind[0]))
         self.all_planar = bool(self.planar.all())
 
-    def poses(self, label: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None]:
+    def poses(self, label: np.ndarray | int, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None]:
         """Poses of objects ``label`` at times ``t`` (one per pair).
 
         Parameters
         ----------
-        label : (P,) int
-            Object (index into ``motions``) of each pair.
+        label : (P,) int, or int
+            Object (index into ``motions``) of each pair, or one object for all.
         t : (P,) float64
             Time of each pair, seconds.
 
@@ -552,31 +585,48 @@ class _PoseBank:
         pitch, roll : (P,) float64, or None where all of them are zero (planar motions only)
             FLU Euler angles, radians.
         """
-        p = label.size
+        p = t.size
+        one = np.ndim(label) == 0
+        if one:
+            k = int(label)
+            planar = bool(self.planar[k])
+            kinds = [int(self.kind[k])]
+        else:
+            planar = self.all_planar or bool(np.take(self.planar, label).all())
+            kinds = [int(self.kind[0])] if self.single_kind else np.unique(np.take(self.kind, label)).tolist()
         position = np.empty((3, p))
         yaw = np.empty(p)
-        planar = self.all_planar or bool(self.planar[label].all())
         pitch = None if planar else np.zeros(p)
         roll = None if planar else np.zeros(p)
-        kinds = [int(self.kind[0])] if self.single_kind else np.unique(self.kind[label]).tolist()
         for kind in kinds:
-            idx = None if len(kinds) == 1 else np.flatnonzero(self.kind[label] == kind)
-            lab = label if idx is None else label[idx]
+            idx = None if len(kinds) == 1 else np.flatnonzero(np.take(self.kind, label) == kind)
+            lab = np.full(1, k) if one else (label if idx is None else label[idx])  # one: broadcast
             tt = t if idx is None else t[idx]
             sel = slice(None) if idx is None else idx
             if kind == _KIND_CONSTANT_VELOCITY:  # ConstantVelocity.poses
-                position[:, sel] = self.cv_position[:, lab] + tt * self.cv_velocity[:, lab]
-                yaw[sel] = self.cv_yaw[lab] + self.cv_yaw_rate[lab] * tt
+                vel = np.take(self.cv_velocity, lab, axis=1) * tt
+                vel += np.take(self.cv_position, lab, axis=1)  # p0 + t v
+                position[:, sel] = vel
+                yaw[sel] = np.take(self.cv_yaw, lab) + np.take(self.cv_yaw_rate, lab) * tt
             elif kind == _KIND_TRACK:  # SampledTrack.poses (+ ShipMotion's waves)
-                u = np.clip(tt / self.tr_dt[lab], 0.0, self.tr_last[lab])
-                i = np.minimum(u.astype(np.int64), self.tr_imax[lab])
+                u = np.clip(tt / np.take(self.tr_dt, lab), 0.0, np.take(self.tr_last, lab))
+                i = np.minimum(u.astype(np.int64), np.take(self.tr_imax, lab))
                 f = u - i
-                i += self.tr_base[lab]
-                a = self.tr_samples[:, i]
-                v = a + (self.tr_samples[:, i + 1] - a) * f
-                w = np.flatnonzero(self.has_waves[lab])
-                if w.size:
-                    wp, tw = self.waves[:, lab[w]], tt[w]
+                i += np.take(self.tr_base, lab)
+                a = np.take(self.tr_samples, i, axis=1)
+                v = np.take(self.tr_samples, i + 1, axis=1)
+                v -= a
+                v *= f
+                v += a  # a + (b - a) * f
+                if one:
+                    w = slice(None) if self.has_waves[k] else None
+                    wp = self.waves[:, k : k + 1]
+                else:
+                    w = np.flatnonzero(np.take(self.has_waves, lab))
+                    w = w if w.size else None
+                    wp = None if w is None else np.take(self.waves, lab[w], axis=1)
+                if w is not None:
+                    tw = tt[w]
                     v[5, w] = v[5, w] + wp[0] * np.sin(wp[1] * tw + wp[2])  # roll
                     v[4, w] = v[4, w] + -(wp[3] * np.sin(wp[4] * tw + wp[5]))  # pitch (marine sign flipped)
                     v[2, w] += wp[6] * np.sin(wp[7] * tw + wp[8])  # heave
@@ -585,9 +635,9 @@ class _PoseBank:
                 if pitch is not None:
                     pitch[sel], roll[sel] = v[4], v[5]
             else:
-                for k in np.unique(lab).tolist():
-                    j = np.flatnonzero(lab == k)
-                    pose = self.motions[k].poses(tt[j])
+                groups = [(k, np.arange(p))] if one else [(m, np.flatnonzero(lab == m)) for m in np.unique(lab).tolist()]
+                for m, j in groups:
+                    pose = self.motions[m].poses(tt[j])
                     rows = j if idx is None else idx[j]
                     position[:, rows] = pose.position_m.T
                     yaw[rows] = pose.yaw_rad
@@ -636,7 +686,7 @@ def _swept_spheres(
         j = np.arange(label.size) - start[label]
         pos = bank.poses(label, tmin + (j + 0.5) * (span / k[label]))[0]
         centre = (np.minimum.reduceat(pos, start, axis=1) + np.maximum.reduceat(pos, start, axis=1)) / 2
-        dev = pos - centre[:, label]
+        dev = pos - np.take(centre, label, axis=1)
         path = np.sqrt(np.maximum.reduceat(np.einsum("ij,ij->j", dev, dev), start))
     radius = mesh_radii + path + speeds * span / (2 * k)
     radius += _SPHERE_PAD_M + 1e-6 * (radius + np.abs(centre).max(axis=0))
@@ -804,7 +854,7 @@ class _StaticPart:
 
 @dataclass
 class _Body:
-    """A distinct moving mesh (shared by the objects that use the same one)."""
+    """A distinct moving mesh (shared by the objects that use the same one; each still gets its atlas copy)."""
 
     radius_m: float  # max vertex distance from the body origin
 
@@ -864,7 +914,7 @@ class _Batch:
 
 
 def _mesh_key(vertices: np.ndarray, faces: np.ndarray) -> bytes:
-    """Content hash of a mesh (objects with equal meshes share one body scene)."""
+    """Content hash of a mesh (objects with equal meshes share one :class:`_Body` record)."""
     h = hashlib.blake2b(digest_size=16)
     h.update(np.ascontiguousarray(vertices, dtype=np.float64).tobytes())
     h.update(np.ascontiguousarray(faces, dtype=np.int64).tobytes())
@@ -919,8 +969,7 @@ def _static_results_part(
         e = min(b, s + _CHUNK)
         np.copyto(rng[s:e], t32[s:e])
         g = gid[s:e]
-        hit = np.flatnonzero(g >= 0)
-        if hit.size > (e - s) // 8:
+        if 16 * np.count_nonzero(g[::16] >= 0) > (e - s) // 8:  # many hits (a subsample decides)
             np.take(st.geometry_object_ext, g, out=obj[s:e], mode="wrap")
             face = np.take(st.geometry_face_offset_ext, g, mode="wrap")
             face += prim[s:e]
@@ -935,6 +984,7 @@ def _static_results_part(
         else:
             obj[s:e] = NO_HIT
             material[s:e] = -1
+            hit = np.flatnonzero(g >= 0)
             j = hit + s
             gh = g[hit]
             obj[j] = st.geometry_object[gh]
@@ -1077,7 +1127,7 @@ class Scene:
         )
 
     def _build_movers(self, objects: list[SceneObject]) -> list[_Mover]:
-        """One body-frame scene per distinct mesh; one entry per moving object."""
+        """One entry per moving object; its body record (bounding radius) computed once per distinct mesh."""
         bodies: dict[bytes, _Body] = {}
         movers = []
         for obj in objects:
@@ -1093,13 +1143,15 @@ class Scene:
         """ONE Open3D scene holding every moving object's body-frame mesh in its own cell.
 
         Object k's mesh (its own copy, even where objects share a mesh) sits at
-        ``offset[:, k]``, the centre of cell k of a compact cubic grid whose spacing is
-        twice the largest bounding radius plus 10 m, so the cells' bounding spheres are
-        disjoint and coordinates stay within a few kilometres of the atlas origin
-        (float32 keeps sub-millimetre precision). A batch casts all objects' candidate
-        rays in one call: each ray starts at the entry of its own object's sphere, so a
-        hit on its own object, if any, comes before anything in another cell (geometry
-        id = object label).
+        ``offset[:, k]``, the centre of cell k of a square grid in the body x-z plane
+        whose spacing is twice the largest bounding radius plus 10 m, so the cells'
+        bounding spheres are disjoint and coordinates stay within a few kilometres of the
+        atlas origin (float32 keeps sub-millimetre precision). A batch casts all
+        objects' candidate rays in one call: each ray starts at the entry of its own
+        object's sphere, so a hit on its own object, if any, comes before anything in
+        another cell (geometry id = object label). The grid is a vertical plane because
+        sensors see bodies along near-horizontal rays: a ray that misses its object
+        leaves the plane instead of crossing other cells (which costs Embree time).
 
         Parameters
         ----------
@@ -1117,11 +1169,11 @@ class Scene:
             return None, np.zeros((3, 0))
         spacing = 2.0 * float(radii.max()) + 10.0
         side = 1
-        while side**3 < len(movers):
+        while side**2 < len(movers):
             side += 1
         index = np.arange(len(movers))
-        cells = np.stack([index % side, (index // side) % side, index // (side * side)]).astype(np.float64)
-        offsets = (cells - (side - 1) / 2.0) * spacing
+        cells = np.stack([index % side, np.full(len(movers), (side - 1) / 2.0), index // side]).astype(np.float64)
+        offsets = (cells - (side - 1) / 2.0) * spacing  # y = 0
         scene = o3d.t.geometry.RaycastingScene(nthreads=self.nthreads)
         for k, mover in enumerate(movers):
             vertices = np.asarray(mover.obj.vertices_m, dtype=np.float64) + offsets[:, k]
@@ -1232,7 +1284,9 @@ class Scene:
             if self.sea:
                 batch.sea_range = intersect_sea(batch.origins[:, 2], batch.directions[:, 2])
             return
-        lo, hi = _origin_box(batch.origins)
+        parts = _split_run(batch.n, self._workers, lambda a, b: _origin_box(batch.origins[a:b]))
+        lo = np.min([p[0] for p in parts], axis=0)
+        hi = np.max([p[1] for p in parts], axis=0)
         batch.origin_centre = (lo + hi) / 2
         batch.spread_m = float(np.linalg.norm(hi - lo) / 2) * (1 + 1e-9) + 1e-9
         near_table = self._static_near_table(batch) if self._static is not None else None
@@ -1423,12 +1477,14 @@ class Scene:
         prim = res["primitive_ids"].numpy().view(np.int32)[j]
         n_body = res["primitive_normals"].numpy()[j].astype(np.float64)
         if carrier.rotation is not None:
-            rot = np.asarray(carrier.rotation, dtype=np.float64)[j]
+            n_world = np.einsum("nij,nj->ni", np.asarray(carrier.rotation, dtype=np.float64)[j], n_body)
         else:
-            _, yaw, pitch, roll = self._bank.poses(np.full(j.size, k), np.take(batch.times, j))
-            zeros = np.zeros(j.size)
-            rot = rotation_matrices(yaw, zeros if pitch is None else pitch, zeros if roll is None else roll)
-        n_world = np.einsum("nij,nj->ni", rot, n_body)
+            _, yaw, pitch, roll = self._bank.poses(k, np.take(batch.times, j))
+            if pitch is None:  # yaw only
+                c, s = np.cos(yaw), np.sin(yaw)
+                n_world = np.stack([c * n_body[:, 0] - s * n_body[:, 1], s * n_body[:, 0] + c * n_body[:, 1], n_body[:, 2]], axis=1)
+            else:
+                n_world = np.einsum("nij,nj->ni", rotation_matrices(yaw, pitch, roll), n_body)
         flip = np.einsum("ni,ni->n", n_world, np.take(batch.directions, j, axis=0)) > 0
         n_world[flip] *= -1.0
         hits.range_m[j] = t32[j]
@@ -1479,15 +1535,20 @@ class Scene:
                 _pairs_reach_spheres(o, d, np.take(centres.T, label, axis=1), np.take(radii, label), np.take(limit, ray))
             )
             if keep.size < ray.size:
-                ray, label, o, d = ray[keep], label[keep], o[:, keep], d[:, keep]
-            rays.append(ray), labels.append(label), os_.append(o), ds.append(d)
+                ray, label, o, d = ray[keep], label[keep], np.take(o, keep, axis=1), np.take(d, keep, axis=1)
+            rays.append(ray)
+            labels.append(label)
+            os_.append(o)
+            ds.append(d)
         for k in around.tolist():
             # An object seen in every direction (e.g. the ship carrying the sensor, when
             # no carrier is given): its rays in ray order (runs of equal times share one
             # pose); a sphere test would filter next to nothing.
             ray = np.flatnonzero(limit > cells.near_m[k])
-            rays.append(ray), labels.append(np.full(ray.size, k))
-            os_.append(_gather_columns(batch.origins, ray)), ds.append(_gather_columns(batch.directions, ray))
+            rays.append(ray)
+            labels.append(np.full(ray.size, k))
+            os_.append(_gather_columns(batch.origins, ray))
+            ds.append(_gather_columns(batch.directions, ray))
         if len(rays) > 1:
             ray, label = np.concatenate(rays), np.concatenate(labels)
             o, d = np.concatenate(os_, axis=1), np.concatenate(ds, axis=1)
@@ -1560,7 +1621,7 @@ class Scene:
         else:
             instant = np.cumsum(new) - 1
             position, yaw, pitch, roll = self._bank.poses(label[first], times[first])
-            position = position[:, instant]
+            position = np.take(position, instant, axis=1)
         planar = pitch is None
         if planar:  # yaw only: R = Rz(yaw)
             rot = np.stack([np.cos(yaw), np.sin(yaw)])  # (2, U)
@@ -1570,7 +1631,7 @@ class Scene:
             instant = np.arange(ray.size)
             r = rot
         else:
-            r = rot[:, instant]
+            r = np.take(rot, instant, axis=1)
         w = o - position
         body_o, body_d = np.empty((3, ray.size)), np.empty((3, ray.size))
         for src, dst in ((w, body_o), (d, body_d)):  # R^T v
@@ -1589,7 +1650,7 @@ class Scene:
             return None
         if inside.size < ray.size:
             ray, label, instant = ray[inside], label[inside], instant[inside]
-            body_o, body_d, d = body_o[:, inside], body_d[:, inside], d[:, inside]
+            body_o, body_d, d = (np.take(x, inside, axis=1) for x in (body_o, body_d, d))
         # One Open3D call for all objects (the atlas): each ray starts where it enters
         # its object's bounding sphere (float64), moved into the object's atlas cell.
         b = np.einsum("ij,ij->j", body_o, body_d)
@@ -1612,13 +1673,13 @@ class Scene:
         if sel.size == 0:
             return None
         n_b = res["primitive_normals"].numpy()[sel].T.astype(np.float64)  # (3, S) body frame
-        r = rot[:, instant[sel]]
+        r = np.take(rot, instant[sel], axis=1)
         if planar:  # R n
             c, s = r
             n_world = np.stack([c * n_b[0] - s * n_b[1], s * n_b[0] + c * n_b[1], n_b[2]], axis=1)
         else:
             n_world = np.stack([r[3 * i] * n_b[0] + r[3 * i + 1] * n_b[1] + r[3 * i + 2] * n_b[2] for i in range(3)], axis=1)
-        flip = np.einsum("ni,in->n", n_world, d[:, sel]) > 0
+        flip = np.einsum("ni,in->n", n_world, np.take(d, sel, axis=1)) > 0
         n_world[flip] *= -1.0
         prim = res["primitive_ids"].numpy().view(np.int32)[sel]
         return {"ray": ray[sel], "label": label[sel], "t": t[sel], "prim": prim, "normal": n_world}
