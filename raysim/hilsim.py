@@ -31,7 +31,7 @@ from pathlib import Path
 import yaml
 
 from raysim.errors import InputError
-from raysim.scenario import DOUGLAS_WAVE_HEIGHT_M
+from raysim.scenario import DOUGLAS_WAVE_HEIGHT_M, read_yaml
 
 MMSI_BASE = 257_000_000  # MID 257 = Norway, where the thesis's scenario sails
 
@@ -72,20 +72,7 @@ def _ais_noise_key(field: str) -> str:
 
 
 def _load(path: Path) -> dict:
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise InputError(str(path), "(file)", "file not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(str(path), "(file)", f"cannot read: {exc}") from None
-    if not text.strip():
-        raise InputError(str(path), "(file)", "file is empty")
-    try:
-        data = yaml.safe_load(text)
-    except yaml.MarkedYAMLError as exc:
-        mark = exc.problem_mark
-        where = f"line {mark.line + 1}, column {mark.column + 1}" if mark else "(file)"
-        raise InputError(str(path), where, f"not valid YAML: {exc.problem}") from None
+    data = read_yaml(Path(path))
     if not isinstance(data, dict):
         raise InputError(str(path), "(top level)", "must be a mapping of keys to values")
     return data

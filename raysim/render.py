@@ -18,7 +18,7 @@ from typing import Callable
 import numpy as np
 from tqdm import tqdm
 
-from raysim import __version__
+from raysim import __version__, schema
 from raysim.pose import heading_deg_from_yaw
 from raysim.recording.jsonl import course_and_speed, write_ownship_chunk, write_truth_chunk
 from raysim.recording.staging import MANIFEST, StagedDirectory, atomic_path
@@ -188,7 +188,7 @@ def render(scenario: Scenario, out_dir: Path, progress: bool | None = None) -> R
             "format_version": 1,
             "scenario": scenario.name,
             "seed": scenario.seed,
-            "start_time": scenario_to_yaml_time(scenario),
+            "start_time": schema.to_plain(scenario.start_time),
             "duration_s": scenario.duration_s,
             "sensors_enabled": list(enabled),
             "sensors_rendered": rendered,
@@ -203,7 +203,3 @@ def render(scenario: Scenario, out_dir: Path, progress: bool | None = None) -> R
         staged.commit()
     return RenderResult(Path(out_dir), manifest)
 
-
-def scenario_to_yaml_time(scenario: Scenario) -> str:
-    """The scenario's start time as ISO 8601 UTC with a Z."""
-    return scenario.start_time.strftime("%Y-%m-%dT%H:%M:%S.%fZ").replace(".000000Z", "Z")

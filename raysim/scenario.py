@@ -288,7 +288,8 @@ class Scenario:
 # ---------------------------------------------------------------------------- loading
 
 
-def _read_yaml(path: Path) -> object:
+def read_yaml(path: Path) -> object:
+    """Parse a YAML file with ``yaml.safe_load``; any problem is an :class:`InputError` naming the place."""
     try:
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
@@ -320,7 +321,7 @@ def load_scenario(path: str | Path, resolve_defaults: bool = True) -> Scenario:
         For every kind of bad input, naming the file, the key path and the problem.
     """
     path = Path(path)
-    data = _read_yaml(path)
+    data = read_yaml(path)
     if data is None:
         raise InputError(str(path), "(file)", "file holds no scenario (only comments?)")
     if not isinstance(data, dict):
