@@ -16,7 +16,9 @@ Sources and conventions (see /work/shared/REFERENCE.md sections 2 and 3):
   X band (9.41 GHz): 0 dB for metal; for dielectrics it is computed here from the Fresnel
   normal-incidence formula ``|(1 - sqrt(er)) / (1 + sqrt(er))|^2`` with the material's
   ``relative_permittivity`` (ice, er = 3.15, gives about -11 dB, REFERENCE section 3 item 6).
-- ``specular_exponent`` is the exponent ``n`` of the radar specular lobe ``cos^n(theta)``
+- ``radar_roughness_m`` is the rms surface height that splits the radar reflection into a
+  coherent (facet physical optics) and an incoherent part (Rayleigh roughness; unverified defaults).
+- ``specular_exponent`` is the exponent ``n`` of the radar rough-surface lobe ``cos^n(theta)``
   (theta = angle between the facet normal and the direction back to the radar). It is derived
   here from a documented half-power half-width of the lobe: a smooth metal plate has a very
   narrow lobe (large n), rough ice and snow a broad one (small n). All lobe widths are
@@ -58,7 +60,11 @@ class Material:
     relative_permittivity : float or None
         Real relative permittivity at X band for dielectrics; None for conductors.
     specular_exponent : float
-        Exponent n of the radar specular lobe ``cos^n(theta)``; larger is sharper.
+        Exponent n of the radar rough-surface lobe ``cos^n(theta)``; larger is sharper.
+    radar_roughness_m : float
+        Rms surface height at radar wavelengths, m: the coherent (mirror-like) fraction of the
+        reflection is ``exp(-(4 pi h cos(theta) / lambda)^2)`` (Rayleigh roughness), the rest goes
+        into the rough-surface lobe.
     source : str
         Where the numbers come from; "(unverified)" marks engineering defaults.
     """
@@ -69,6 +75,7 @@ class Material:
     radar_reflectivity_db: float
     relative_permittivity: float | None
     specular_exponent: float
+    radar_roughness_m: float
     source: str
 
 
@@ -148,9 +155,19 @@ VERY_ROUGH_HALF_WIDTH_DEG = 45.0
 # Trihedral corner reflector: -3 dB full beam width about 40 deg (unverified).
 CORNER_REFLECTOR_HALF_WIDTH_DEG = 20.0
 
+# --- Radar rms roughness heights (engineering defaults, unverified) ---------------------------
+# Rayleigh criterion at lambda = 3.19 cm: h << lambda / (8 cos) ~ 4 mm is smooth. Painted plate,
+# gelcoat: 0.5 mm (mirror-like); weathered berg ice: 1 cm (fully rough at X band); snow 2 cm;
+# timber, concrete, rubber: 3 mm; asphalt 5 mm; the sea is never a target (its echo is clutter): 0.
+SMOOTH_ROUGHNESS_M = 0.0005
+ICE_ROUGHNESS_M = 0.01
+SNOW_ROUGHNESS_M = 0.02
+ROUGH_ROUGHNESS_M = 0.003
+ASPHALT_ROUGHNESS_M = 0.005
+
 
 def _dielectric(
-    name: str, reflectance_905nm: float, permittivity: float, half_width_deg: float, source: str
+    name: str, reflectance_905nm: float, permittivity: float, half_width_deg: float, roughness_m: float, source: str
 ) -> Material:
     """A non-retroreflective dielectric material with Fresnel radar reflectivity."""
     return Material(
@@ -160,12 +177,13 @@ def _dielectric(
         radar_reflectivity_db=fresnel_normal_reflectivity_db(permittivity),
         relative_permittivity=permittivity,
         specular_exponent=specular_exponent_from_half_width_deg(half_width_deg),
+        radar_roughness_m=roughness_m,
         source=source,
     )
 
 
 def _conductor(
-    name: str, reflectance_905nm: float, retroreflective: bool, half_width_deg: float, source: str
+    name: str, reflectance_905nm: float, retroreflective: bool, half_width_deg: float, roughness_m: float, source: str
 ) -> Material:
     """A metallic (perfectly conducting at X band, 0 dB) material."""
     return Material(
@@ -175,6 +193,7 @@ def _conductor(
         radar_reflectivity_db=0.0,
         relative_permittivity=None,
         specular_exponent=specular_exponent_from_half_width_deg(half_width_deg),
+        radar_roughness_m=roughness_m,
         source=source,
     )
 
@@ -183,56 +202,56 @@ def _conductor(
 #: The order is stable: append new materials at the end, never reorder.
 MATERIALS: tuple[Material, ...] = (
     _conductor(
-        "steel_painted", 0.30, False, SMOOTH_HALF_WIDTH_DEG,
+        "steel_painted", 0.30, False, SMOOTH_HALF_WIDTH_DEG, SMOOTH_ROUGHNESS_M,
         "905 nm: 0.30 for grey/white marine paint (unverified); radar: metal, 0 dB.",
     ),
     _conductor(
-        "aluminium", 0.60, False, SMOOTH_HALF_WIDTH_DEG,
+        "aluminium", 0.60, False, SMOOTH_HALF_WIDTH_DEG, SMOOTH_ROUGHNESS_M,
         "905 nm: weathered aluminium 0.59-0.61 at 0.9 um (HELIOS++ spectral library, "
         "REFERENCE.md section 2); radar: metal, 0 dB.",
     ),
     _dielectric(
-        "ice", 0.40, ICE_PERMITTIVITY, ICE_HALF_WIDTH_DEG,
+        "ice", 0.40, ICE_PERMITTIVITY, ICE_HALF_WIDTH_DEG, ICE_ROUGHNESS_M,
         "905 nm: 0.40, iceberg ice is darker in the near infrared than in the visible "
         "(REFERENCE.md section 2; value unverified); radar: Fresnel with er = 3.15 "
         "(REFERENCE.md section 3 item 6), about -11 dB.",
     ),
     _dielectric(
-        "snow", 0.80, SNOW_PERMITTIVITY, VERY_ROUGH_HALF_WIDTH_DEG,
+        "snow", 0.80, SNOW_PERMITTIVITY, VERY_ROUGH_HALF_WIDTH_DEG, SNOW_ROUGHNESS_M,
         "905 nm: 0.80 for fresh snow at 0.9 um (unverified); radar: Fresnel with dry-snow "
         "er = 1.6 (unverified).",
     ),
     _dielectric(
-        "grp", 0.50, GRP_PERMITTIVITY, GRP_HALF_WIDTH_DEG,
+        "grp", 0.50, GRP_PERMITTIVITY, GRP_HALF_WIDTH_DEG, SMOOTH_ROUGHNESS_M,
         "905 nm: 0.50 for white gelcoat (unverified); radar: Fresnel with er = 4.0, "
         "about -10 dB (unverified).",
     ),
     _dielectric(
-        "wood", 0.45, WOOD_PERMITTIVITY, ROUGH_HALF_WIDTH_DEG,
+        "wood", 0.45, WOOD_PERMITTIVITY, ROUGH_HALF_WIDTH_DEG, ROUGH_ROUGHNESS_M,
         "905 nm: 0.45 for weathered timber (unverified); radar: Fresnel with er = 2.0 "
         "(unverified).",
     ),
     _dielectric(
-        "concrete", 0.40, CONCRETE_PERMITTIVITY, ROUGH_HALF_WIDTH_DEG,
+        "concrete", 0.40, CONCRETE_PERMITTIVITY, ROUGH_HALF_WIDTH_DEG, ROUGH_ROUGHNESS_M,
         "905 nm: 0.40 (unverified); radar: Fresnel with er = 6.0 (unverified).",
     ),
     _dielectric(
-        "asphalt", 0.28, ASPHALT_PERMITTIVITY, VERY_ROUGH_HALF_WIDTH_DEG,
+        "asphalt", 0.28, ASPHALT_PERMITTIVITY, VERY_ROUGH_HALF_WIDTH_DEG, ASPHALT_ROUGHNESS_M,
         "905 nm: asphalt 0.28 at 0.9 um (HELIOS++ spectral library, REFERENCE.md section 2); "
         "radar: Fresnel with er = 4.0 (unverified).",
     ),
     _dielectric(
-        "rubber", 0.05, RUBBER_PERMITTIVITY, ROUGH_HALF_WIDTH_DEG,
+        "rubber", 0.05, RUBBER_PERMITTIVITY, ROUGH_HALF_WIDTH_DEG, ROUGH_ROUGHNESS_M,
         "905 nm: 0.05 for black fender rubber (unverified); radar: Fresnel with er = 3.0 "
         "(unverified).",
     ),
     _conductor(
-        "retroreflector", 1.0, True, CORNER_REFLECTOR_HALF_WIDTH_DEG,
+        "retroreflector", 1.0, True, CORNER_REFLECTOR_HALF_WIDTH_DEG, SMOOTH_ROUGHNESS_M,
         "905 nm: retro-reflective (HDL-32E reports 101-255, REFERENCE.md section 2), "
         "diffuse part 1.0 (unverified); radar: 0 dB, corner-reflector-like lobe (unverified).",
     ),
     _dielectric(
-        "sea", 0.02, SEA_WATER_PERMITTIVITY, SMOOTH_HALF_WIDTH_DEG,
+        "sea", 0.02, SEA_WATER_PERMITTIVITY, SMOOTH_HALF_WIDTH_DEG, 0.0,
         "905 nm: 0.02, Fresnel reflectance of water, specular (REFERENCE.md section 2); "
         "radar: Fresnel with sea-water er = 60 at X band (unverified).",
     ),
@@ -279,7 +298,7 @@ def material_table() -> dict[str, np.ndarray]:
     dict of str to numpy.ndarray
         Fresh arrays of shape (M,), M = ``len(MATERIALS)``, aligned with :data:`MATERIALS`:
         ``reflectance_905nm`` float32 (0..1), ``retroreflective`` bool,
-        ``radar_reflectivity_db`` float32 (dB re. metal), ``specular_exponent`` float32.
+        ``radar_reflectivity_db`` float32 (dB re. metal), ``specular_exponent`` float32, ``radar_roughness_m`` float32.
     """
     return {
         "reflectance_905nm": np.array([m.reflectance_905nm for m in MATERIALS], dtype=np.float32),
@@ -288,19 +307,20 @@ def material_table() -> dict[str, np.ndarray]:
             [m.radar_reflectivity_db for m in MATERIALS], dtype=np.float32
         ),
         "specular_exponent": np.array([m.specular_exponent for m in MATERIALS], dtype=np.float32),
+        "radar_roughness_m": np.array([m.radar_roughness_m for m in MATERIALS], dtype=np.float32),
     }
 
 
 def describe_markdown() -> str:
     """Markdown table of the material table with sources (docs/physics.md embeds it)."""
     lines = [
-        "| index | material | reflectance 905 nm | retro | permittivity | radar dB | specular n | source |",
-        "|---|---|---|---|---|---|---|---|",
+        "| index | material | reflectance 905 nm | retro | permittivity | radar dB | lobe n | roughness mm | source |",
+        "|---|---|---|---|---|---|---|---|---|",
     ]
     for i, m in enumerate(MATERIALS):
         er = "-" if m.relative_permittivity is None else f"{m.relative_permittivity:g}"
         lines.append(
             f"| {i} | `{m.name}` | {m.reflectance_905nm:.2f} | {'yes' if m.retroreflective else 'no'} | {er} | "
-            f"{m.radar_reflectivity_db:.2f} | {m.specular_exponent:.1f} | {m.source} |"
+            f"{m.radar_reflectivity_db:.2f} | {m.specular_exponent:.1f} | {1000 * m.radar_roughness_m:g} | {m.source} |"
         )
     return "\n".join(lines) + "\n"

@@ -168,6 +168,18 @@ class Radar:
     spokes: int = param(2048, doc="Spokes per revolution", ge=64, le=8192)
     samples: int = param(1024, doc="Samples per spoke", ge=64, le=4096)
     mount: Mount = param(default_factory=lambda: Mount(z_m=4.0), doc="Mounting on the own ship (body frame)")
+    polarisation: Literal["HH", "VV"] = param("HH", doc="Polarisation (marine X-band sets are HH); sets the NRL clutter and K shape")
+    sea_clutter_control_db: float = param(
+        20.0, doc="Sea control (STC): attenuation at 100 m, rising 40 dB/decade to 0; 0 turns it off", ge=0, le=80)
+    rain_clutter_control_m: float = param(
+        0.0, doc="Rain control (FTC): range time constant of the log-video high-pass, m; 0 turns it off", ge=0)
+    blanking_m: float = param(3.0, doc="Main-bang blanking: samples nearer than this read 0, m", ge=0)
+    multipath: bool = param(True, doc="Two-ray interference of the direct and sea-reflected paths")
+    earth_curvature: bool = param(True, doc="4/3-earth radar horizon: what lies below it is not seen")
+    beam_az_deg: float = param(5.2, doc="Horizontal -3 dB beam width, deg (18 in dome)", gt=0, le=45)
+    beam_el_deg: float = param(25.0, doc="Vertical -3 dB beam width, deg", gt=0, le=90)
+    resolve_m: float = param(
+        6.0, doc="Ray spacing across the beam at the range scale (or the horizon if nearer), m", gt=0, le=100)
 
 
 @dataclass(frozen=True, kw_only=True)

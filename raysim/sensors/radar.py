@@ -33,9 +33,10 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
-from scipy.ndimage import gaussian_filter1d
+from scipy.ndimage import gaussian_filter1d, uniform_filter1d
+from scipy.signal import lfilter
 
-from raysim.materials import material_index, material_table
+from raysim.materials import material_table
 from raysim.pose import heading_deg_from_yaw
 from raysim.random_streams import stream
 from raysim.recording.npz import write_npz
@@ -43,12 +44,21 @@ from raysim.recording.ppi import write_ppi
 from raysim.scene import NO_HIT, SEA_ID
 from raysim.sensors import radar_physics as phys
 from raysim.sensors.carrier import CarrierScene
+from raysim.sensors.radar_facets import FacetTable
+from raysim.sensors.radar_texture import SeaTexture
 from raysim.sensors.lidar import mount_transform
+
+
+#: mean of 10 log10 of exponential noise power of mean 1: -10 gamma / ln 10 (Euler's gamma), dB
+NOISE_LOG_MEAN_DB = -2.507
 
 
 @dataclass(frozen=True)
 class RadarParams:
-    """Radar model parameters with their defaults (sources in :mod:`raysim.sensors.radar_physics`)."""
+    """Radar model parameters with their defaults (sources in :mod:`raysim.sensors.radar_physics`).
+
+    The scenario's ``sensors.radar`` keys set the operator-facing ones (:meth:`from_config`).
+    """
 
     f_ghz: float = phys.FREQUENCY_GHZ
     pt_w: float = phys.PT_W
@@ -60,9 +70,9 @@ class RadarParams:
     beam_el_deg: float = phys.BEAM_EL_DEG
     range_resolution_m: float = phys.RANGE_RESOLUTION_M
     polarisation: str = "HH"  # marine X-band radars are horizontally polarised
-    # target scattering (REF 3.6; gains unverified engineering defaults)
+    # target scattering (REF 3.6): gain of the materials' rough-surface lobe (unverified engineering default);
+    # the specular part is facet physical optics, calibrated on the flat plate (no free gain)
     diffuse_gain: float = 1.0
-    specular_gain: float = 30.0
     # receiver (REF 3.10): video level v = floor((SNR_dB + STC - floor_db) / step_db), clipped 0..15.
     # floor 6.6 dB + one 3 dB step = 9.6 dB threshold: noise alone crosses it with Pfa ~ 1e-4 (REF 3 table)
     video_floor_db: float = 6.6
@@ -72,25 +82,38 @@ class RadarParams:
     stc_a0_db: float = 20.0
     stc_n: float = 4.0  # REF 3.10: 3..4
     stc_r0_m: float = 100.0
-    # geometry
+    ftc_m: float = 0.0  # rain control (FTC): range time constant of the log-video high-pass, m; 0 = off
+    blanking_m: float = 3.0  # main-bang blanking: samples nearer than this are 0 (unverified; FMCW, REF 3 table)
+    # propagation
     earth_curvature: bool = True  # drop hits below the 4/3-earth radar horizon (REF 3.4)
-    elevation_up_deg: tuple = (5.0, 2.0, 0.0)  # rays at and above the horizon, antenna frame
-    elevation_min_deg: float = -10.0  # steepest down-looking ray
-    az_ray_spacing_deg: float = 0.2  # widest azimuth step between rays (small targets must not fall between)
-    down_rays: int = 10  # rays aimed at the sea between the -10 deg ray and 1.5 x range scale
+    multipath: bool = True  # two-ray interference over the sea (REF 3.5)
+    # ray fan: rays at most resolve_m apart at the range scale (capped at the horizon of a top_height_m
+    # object), so a 15 m berg there gets about 2.5 rays each way (issue 4)
+    resolve_m: float = 6.0
+    top_height_m: float = 40.0  # tallest object the fan is dense enough for at the resolve range
+    low_height_m: float = 1.0  # lowest object the fan's sea-going rays catch at every range
+    elevation_max_deg: float = 20.0
+    elevation_min_deg: float = -10.0
     rain_height_m: float = 1500.0  # top of the rain layer (unverified)
 
+    @classmethod
+    def from_config(cls, cfg) -> "RadarParams":
+        """The parameters a scenario's ``sensors.radar`` block sets (the rest at their defaults)."""
+        return cls(polarisation=cfg.polarisation, stc_a0_db=cfg.sea_clutter_control_db,
+                   ftc_m=cfg.rain_clutter_control_m, blanking_m=cfg.blanking_m, multipath=cfg.multipath,
+                   earth_curvature=cfg.earth_curvature, beam_az_deg=cfg.beam_az_deg, beam_el_deg=cfg.beam_el_deg,
+                   resolve_m=cfg.resolve_m)
 
-def _elevations(mount_height_m: float, range_m: float, p: RadarParams) -> tuple[np.ndarray, np.ndarray]:
-    """Elevation angles (rad, antenna frame, descending) and the angular extent each ray stands for."""
-    h = max(mount_height_m, 0.1)
-    d_near = h / math.tan(math.radians(-p.elevation_min_deg))
-    d_far = 1.5 * range_m
-    down = -np.arctan2(h, np.geomspace(d_far, d_near, p.down_rays))
-    el = np.concatenate([np.radians(np.asarray(p.elevation_up_deg, dtype=float)), down])
-    el = np.unique(el)[::-1]
-    edges = np.concatenate([[el[0] + 0.5 * (el[0] - el[1])], 0.5 * (el[1:] + el[:-1]), [el[-1] - 0.5 * (el[-2] - el[-1])]])
-    return el, edges[:-1] - edges[1:]
+
+def _box_wrap(x: np.ndarray, width: int) -> np.ndarray:
+    """Moving average of ``width`` rows along axis 0, circular (azimuth wraps), by cumulative sums."""
+    if width <= 1:
+        return x
+    left = width // 2
+    padded = np.concatenate([x[-left:] if left else x[:0], x, x[: width - left]], axis=0)
+    c = np.cumsum(padded, axis=0, dtype=np.float64)
+    out = (c[width:] - c[:-width]) * (1.0 / width)
+    return out[: x.shape[0]].astype(np.float32)
 
 
 @dataclass
@@ -102,8 +125,10 @@ class Revolution:
     heading_deg: np.ndarray  # (S,) float32
     time: np.ndarray  # (S,) float64
     range_m: np.ndarray  # (N,) float32
-    snr_db: np.ndarray = field(repr=False, default=None)  # (S, N) float32, before quantisation
+    snr_db: np.ndarray = field(repr=False, default=None)  # (S, N) float32, before quantisation (STC, FTC applied)
     first_hit_m: np.ndarray = field(repr=False, default=None)  # (S,) first object hit (inf: none)
+    target_snr: np.ndarray = field(repr=False, default=None)  # (S, N) float32, object echoes alone (linear, re. noise)
+    texture: np.ndarray = field(repr=False, default=None)  # (S, N) float32, clutter texture (mean 1) or None
 
     def arrays(self) -> dict:
         return {"echo": self.echo, "azimuth_deg": self.azimuth_deg, "heading_deg": self.heading_deg,
@@ -118,6 +143,7 @@ class RadarRenderer:
     world : raysim.world.World
     scene : CarrierScene
     params : RadarParams, optional
+        Model parameters; by default those of the scenario's ``sensors.radar`` block.
     """
 
     def __init__(self, world, scene: CarrierScene, params: RadarParams | None = None):
@@ -127,39 +153,53 @@ class RadarRenderer:
         self.cfg = s.sensors.radar
         self.env = s.environment
         self.seed = s.seed
-        self.p = params or RadarParams()
+        self.p = p = params or RadarParams.from_config(self.cfg)
         self.spokes, self.samples = int(self.cfg.spokes), int(self.cfg.samples)
         self.rev_s = 60.0 / self.cfg.rpm
         self.mount_rotation, self.mount_translation = mount_transform(self.cfg.mount)
         # range_m[j] = j dR: the first sample at the antenna, the last at the range scale (REF 3 table)
         self.dr = self.cfg.range_m / (self.samples - 1)
         self.range_m = (np.arange(self.samples) * self.dr).astype(np.float32)
-        self.cell_m = max(self.dr, self.p.range_resolution_m)
+        self.r64 = np.maximum(self.range_m.astype(np.float64), 0.5 * self.dr)
+        self.cell_m = max(self.dr, p.range_resolution_m)
         self.materials = material_table()
-        self.sea_material = material_index("sea")
-        # azimuth sub-rays: the spokes sample azimuth unless coarser than az_ray_spacing_deg
+        self.facets = FacetTable([o for o in world.objects if o.object_id != world.own_ship.object_id])
+        # ray fan: dense enough to resolve p.resolve_m at the range scale or, if nearer, at the radar
+        # horizon of a top_height_m object (beyond it nothing that tall is seen: REF 3.4)
+        h = max(self.cfg.mount.z_m, 0.1)
+        resolve_range = min(self.cfg.range_m, float(phys.horizon_m(h) + phys.horizon_m(p.top_height_m)))
         spoke_deg = 360.0 / self.spokes
-        self.k_az = max(1, int(math.ceil(spoke_deg / self.p.az_ray_spacing_deg - 1e-9)))
+        az_spacing_deg = math.degrees(p.resolve_m / resolve_range)
+        self.k_az = max(1, int(math.ceil(spoke_deg / az_spacing_deg - 1e-9)))
         self.az_offsets_deg = ((np.arange(self.k_az) + 0.5) / self.k_az - 0.5) * spoke_deg
         self.d_az_rad = math.radians(spoke_deg / self.k_az)
-        self.el_rad, self.d_el_rad = _elevations(self.cfg.mount.z_m, self.cfg.range_m, self.p)
+        self.el_rad, self.d_el_rad = phys.elevation_grid_rad(h, resolve_range, p.resolve_m, p.top_height_m, p.low_height_m,
+                                                             p.elevation_max_deg, p.elevation_min_deg)
         self.k = self.k_az * self.el_rad.size
         # two-way azimuth pattern as a circular kernel over spokes (its FFT, reused every revolution)
         offsets = np.arange(self.spokes)
         offsets = np.where(offsets > self.spokes // 2, offsets - self.spokes, offsets) * spoke_deg
-        self.az_kernel_f = np.fft.rfft(phys.two_way_gain(offsets, self.p.beam_az_deg))
+        self.az_kernel_f = np.fft.rfft(phys.two_way_gain(offsets, p.beam_az_deg))
         # clutter / rain cells use the -3 dB width as REF 3.7 does (R theta dR sec psi); the Gaussian
         # two-way pattern's equivalent width would be 0.753 theta3 (1.2 dB less): see docs/radar.md
-        self.beam_eq_rad = math.radians(self.p.beam_az_deg)
-        self.bin_m = self.dr
-        self._clutter_mean_db = np.full(self.samples, -np.inf)  # mean sea clutter SNR of spoke 0, no shadow (diagnostic)
-        self.el_eq_rad = phys.two_way_equivalent_width_rad(self.p.beam_el_deg)
+        self.beam_eq_rad = math.radians(p.beam_az_deg)
+        self.el_eq_rad = phys.two_way_equivalent_width_rad(p.beam_el_deg)
         self.gamma = phys.GammaQuantiles()
-        self.snr_kw = dict(pt_w=self.p.pt_w, gain_dbi=self.p.gain_dbi, f_ghz=self.p.f_ghz, sweep_s=self.p.sweep_s,
-                           noise_figure_db=self.p.noise_figure_db, losses_db=self.p.losses_db)
-        self.rain_db_per_m = float(phys.rain_attenuation_db_per_km(self.env.rain_mm_per_h)) / 1000.0
-        self._clutter_mean_db = phys.db(self._clutter_mean(np.array([max(self.cfg.mount.z_m, 0.05)]),
-                                                           np.array([0.0]))[0])  # level own ship, spoke 0
+        self.snr_kw = dict(pt_w=p.pt_w, gain_dbi=p.gain_dbi, f_ghz=p.f_ghz, sweep_s=p.sweep_s,
+                           noise_figure_db=p.noise_figure_db, losses_db=p.losses_db)
+        self.texture_field = SeaTexture(self.seed, self.env.sea_state, self.env.wind_from_deg)
+        # per-range receiver terms (the same every spoke)
+        self.stc_db = phys.stc_gain_db(self.r64, p.stc_a0_db, p.stc_n, p.stc_r0_m).astype(np.float32)
+        self.rain_loss = phys.undb(-2.0 * float(phys.rain_attenuation_db_per_km(self.env.rain_mm_per_h)) / 1000.0
+                                   * self.r64).astype(np.float32)
+        self.rain_mean = None
+        if self.env.rain_mm_per_h > 0:
+            volume = (self.r64 * self.beam_eq_rad * self.cell_m
+                      * np.minimum(self.r64 * self.el_eq_rad / 2.0, p.rain_height_m))
+            eta = phys.rain_eta_m2_per_m3(self.env.rain_mm_per_h, p.f_ghz)
+            self.rain_mean = phys.snr(eta * volume, self.r64, **self.snr_kw).astype(np.float32)
+        self.blank = int(np.searchsorted(self.range_m, p.blanking_m, side="left"))
+        self._clutter_mean_db = self._clutter_mean_db_table(np.array([max(self.cfg.mount.z_m, 0.05)]))[0]
         self.n_revolutions = int(math.floor(s.duration_s / self.rev_s + 1e-9))
         self.rev_wall_s: list[float] = []
 
@@ -180,24 +220,30 @@ class RadarRenderer:
         d = np.stack(np.broadcast_arrays(ce * np.cos(a), -ce * np.sin(a), np.sin(e) + 0 * a), axis=-1)
         return d.reshape(azimuth_deg.size, self.k, 3)
 
-    def _clutter_mean(self, antenna_h: np.ndarray, sin_tilt: np.ndarray, z_up: np.ndarray | None = None) -> np.ndarray:
-        """(S, N) mean sea clutter (SNR units) without shadow: NRL sigma0 x cell area x vertical gain.
+    def rays(self, rev: int):
+        """The rays of revolution ``rev``: spoke times, poses and the world/body ray arrays."""
+        S, K = self.spokes, self.k
+        idx = np.arange(S)
+        t = (rev * S + idx) / (S * self.cfg.rpm / 60.0)
+        azimuth = idx * (360.0 / S)
+        poses, rot, pos = self._poses(t)
+        d_s = self._sensor_directions(azimuth)  # (S, K, 3)
+        d_w = np.einsum("sij,skj->ski", rot, d_s).reshape(S * K, 3)
+        o_w = np.repeat(pos, K, axis=0)
+        d_b = d_s.reshape(S * K, 3) @ self.mount_rotation.T
+        o_b = np.broadcast_to(self.mount_translation, (S * K, 3))
+        return t, azimuth, poses, rot, pos, o_w, d_w, o_b, d_b
 
-        ``sin_tilt`` (S,): world-z component of the antenna's horizontal boresight (pitch/roll tilt);
-        ``z_up`` (S,): world-z component of the antenna's up axis (1 when level).
-        """
+    def _clutter_mean_db_table(self, antenna_h: np.ndarray) -> np.ndarray:
+        """(H, N) mean sea clutter, dB re. noise, at the level boresight: NRL sigma0 x cell area (no pattern)."""
         p = self.p
-        r = np.maximum(self.range_m.astype(np.float64)[None, :], 0.5 * self.dr)
-        psi = phys.grazing_angle_deg(antenna_h[:, None], r)
+        psi = phys.grazing_angle_deg(antenna_h[:, None], self.r64[None, :])
         psi_c = np.where(np.isfinite(psi), np.maximum(psi, 1e-3), 1.0)
-        area = phys.clutter_cell_area_m2(r, psi_c, self.beam_eq_rad, self.cell_m)
-        sigma0 = phys.undb(phys.nrl_sigma0_db(psi_c, p.f_ghz, self.env.sea_state, p.polarisation))
-        zu = np.ones_like(antenna_h) if z_up is None else z_up
-        psi_r = np.radians(psi_c)
-        sin_el = np.cos(psi_r) * sin_tilt[:, None] - np.sin(psi_r) * zu[:, None]
-        el_ant = np.degrees(np.arcsin(np.clip(sin_el, -1.0, 1.0)))
-        mean = phys.snr(sigma0 * area, r, **self.snr_kw) * phys.two_way_gain(el_ant, p.beam_el_deg)
-        return np.where(np.isfinite(psi), mean, 0.0)
+        area = phys.clutter_cell_area_m2(self.r64[None, :], psi_c, self.beam_eq_rad, self.cell_m)
+        # the NRL fit holds from 0.1 to 60 deg grazing (REF 3.7); steeper cells (the first metres) keep the 60 deg value
+        sigma0_db = phys.nrl_sigma0_db(np.minimum(psi_c, 60.0), p.f_ghz, self.env.sea_state, p.polarisation)
+        mean_db = sigma0_db + phys.db(area) + phys.snr_db(1.0, self.r64[None, :], **self.snr_kw)
+        return np.where(np.isfinite(psi), mean_db, -300.0)  # beyond the horizon: none (finite, for interpolation)
 
     # ------------------------------------------------------------------ one revolution
 
@@ -205,114 +251,143 @@ class RadarRenderer:
         """Render revolution ``rev`` (deterministic: its random streams are named after it)."""
         S, N, K = self.spokes, self.samples, self.k
         p = self.p
-        idx = np.arange(S)
-        t = (rev * S + idx) / (S * self.cfg.rpm / 60.0)
-        azimuth = idx * (360.0 / S)
-        poses, rot, pos = self._poses(t)
+        t, azimuth, poses, rot, pos, o_w, d_w, o_b, d_b = self.rays(rev)
         heading = heading_deg_from_yaw(poses.yaw_rad)
         antenna_h = np.maximum(pos[:, 2], 0.05)
-
-        d_s = self._sensor_directions(azimuth)  # (S, K, 3)
-        d_w = np.einsum("sij,skj->ski", rot, d_s).reshape(S * K, 3)
-        o_w = np.repeat(pos, K, axis=0)
-        times = np.repeat(t, K)
-        d_b = d_s.reshape(S * K, 3) @ self.mount_rotation.T
-        o_b = np.broadcast_to(self.mount_translation, (S * K, 3))
         max_range = self.cfg.range_m * 1.5 + 10.0
-        hits, on_carrier = self.scene.cast(o_w, d_w, times, o_b, d_b, max_range_m=max_range)
+        hits, on_carrier = self.scene.cast(o_w, d_w, np.repeat(t, K), o_b, d_b, max_range_m=max_range)
+        targets, first_hit = self._targets(hits, on_carrier, t, o_w, d_w, antenna_h)
+        clutter, texture = self._sea_clutter(rev, t, rot, pos, azimuth, heading, antenna_h, first_hit)
 
-        # ---- targets: object hits (not the sea, not the own ship, not below the horizon)
+        # ---- receiver: rain clutter, attenuation, thermal noise, STC, FTC, log video, fixed 4-bit levels
+        total = clutter
+        if targets is not None:
+            total = total + targets
+        if self.rain_mean is not None:
+            total = total + self.rain_mean[None, :] * stream(self.seed, f"radar.rain.{rev}").standard_exponential((S, N), dtype=np.float32)
+        total = total * self.rain_loss[None, :] + stream(self.seed, f"radar.noise.{rev}").standard_exponential((S, N), dtype=np.float32)
+        p_db = 10.0 * np.log10(total, dtype=np.float32) + self.stc_db[None, :]
+        if p.ftc_m > 0:
+            p_db = self._ftc(p_db)
+        echo = phys.quantise(p_db, p.video_floor_db, p.video_step_db)
+        echo[:, : self.blank] = 0
+        return Revolution(echo, azimuth.astype(np.float32), heading.astype(np.float32), t, self.range_m,
+                          p_db, first_hit, targets, texture)
+
+    def _targets(self, hits, on_carrier, t, o_w, d_w, antenna_h):
+        """(S, N) object echoes (SNR, linear; None if no object is hit) and the first hit range per spoke."""
+        S, N, K = self.spokes, self.samples, self.k
+        p = self.p
         oid = hits.object_id
-        target = (oid != NO_HIT) & (oid != SEA_ID) & ~on_carrier
-        h = np.flatnonzero(target)
+        h = np.flatnonzero((oid != NO_HIT) & (oid != SEA_ID) & ~on_carrier)
+        first_hit = np.full(S, np.inf)
+        if h.size == 0:
+            return None, first_hit
         r_h = hits.range_m[h]
         spoke_h = h // K
-        el_idx = (h % K) % self.el_rad.size
-        if p.earth_curvature and h.size:
-            point = o_w[h] + r_h[:, None] * d_w[h]
+        point = o_w[h] + r_h[:, None] * d_w[h]
+        if p.earth_curvature:  # below the 4/3-earth horizon: hidden (REF 3.4)
             horiz = np.hypot(point[:, 0] - o_w[h, 0], point[:, 1] - o_w[h, 1])
             visible = point[:, 2] >= phys.hidden_height_m(horiz, antenna_h[spoke_h])
-            h, r_h, spoke_h, el_idx = h[visible], r_h[visible], spoke_h[visible], el_idx[visible]
-        cos_inc = np.abs(np.einsum("ij,ij->i", hits.normal[h].astype(np.float64), d_w[h]))
+            h, r_h, spoke_h, point = h[visible], r_h[visible], spoke_h[visible], point[visible]
+            if h.size == 0:
+                return None, first_hit
+        np.minimum.at(first_hit, spoke_h, r_h)
+        el_idx = (h % K) % self.el_rad.size
+        normal = hits.normal[h].astype(np.float64)
+        cos_ray = -np.einsum("ij,ij->i", normal, d_w[h])
+        area_f, centre = self.facets.lookup(oid[h], hits.primitive[h], t[spoke_h])
+        los = centre - o_w[h]
+        cos_f = -np.einsum("ij,ij->i", normal, los) / np.maximum(np.linalg.norm(los, axis=1), 1e-9)
         mat = hits.material[h]
-        sigma = phys.facet_sigma_m2(self.materials["radar_reflectivity_db"][mat], cos_inc,
-                                    self.materials["specular_exponent"][mat], r_h, self.d_az_rad,
-                                    self.d_el_rad[el_idx], p.diffuse_gain, p.specular_gain)
+        footprint = r_h * r_h * self.d_az_rad * self.d_el_rad[el_idx]
+        sigma = phys.facet_sigma_m2(self.materials["radar_reflectivity_db"][mat], footprint, cos_ray,
+                                    self.materials["specular_exponent"][mat],
+                                    self.materials["radar_roughness_m"][mat], area_f, cos_f, r_h, p.f_ghz,
+                                    p.diffuse_gain)
         sigma = sigma * phys.two_way_gain(np.degrees(self.el_rad[el_idx]), p.beam_el_deg)
+        if p.multipath:
+            sigma = sigma * phys.multipath_f4(antenna_h[spoke_h], point[:, 2], r_h, self.env.sea_state, p.f_ghz)
         power = phys.snr(sigma, r_h, **self.snr_kw)
         bins = np.rint(r_h / self.dr).astype(np.int64)
         ok = bins < N
-        targets = np.bincount(spoke_h[ok] * N + bins[ok], weights=power[ok], minlength=S * N).reshape(S, N)
-        first_hit = np.full(S, np.inf)
-        np.minimum.at(first_hit, spoke_h, r_h)
-        # azimuth beam: circular convolution over spokes; range point-spread when bins are finer than it
-        if h.size:
-            targets = np.fft.irfft(np.fft.rfft(targets, axis=0) * self.az_kernel_f[:, None], n=S, axis=0)
-            np.maximum(targets, 0.0, out=targets)
-            sigma_bins = p.range_resolution_m / 2.3548 / self.dr
-            if sigma_bins > 0.3:
-                targets = gaussian_filter1d(targets, sigma_bins, axis=1, mode="constant") * (math.sqrt(2 * math.pi) * sigma_bins)
+        flat = spoke_h[ok] * N + bins[ok]
+        targets = np.bincount(flat, weights=power[ok], minlength=S * N).reshape(S, N)
+        # range point-spread (physical resolution, REF 3.3) on the spokes hit, when bins are finer than it
+        rows = np.unique(spoke_h[ok])
+        sigma_bins = p.range_resolution_m / 2.3548 / self.dr
+        if sigma_bins > 0.3 and rows.size:
+            targets[rows] = gaussian_filter1d(targets[rows], sigma_bins, axis=1, mode="constant") * (
+                math.sqrt(2 * math.pi) * sigma_bins)
+        # azimuth beam: circular convolution over spokes, on the range bins that hold an echo
+        cols = np.flatnonzero(targets.any(axis=0))
+        if cols.size:
+            sub = np.fft.irfft(np.fft.rfft(targets[:, cols], axis=0) * self.az_kernel_f[:, None], n=S, axis=0)
+            targets[:, cols] = np.maximum(sub, 0.0)
+        return targets.astype(np.float32), first_hit
 
-        # ---- sea clutter (NRL mean, K-distributed), absent in the shadow behind the first hit
-        r = self.range_m.astype(np.float64)[None, :]
-        psi = phys.grazing_angle_deg(antenna_h[:, None], np.maximum(r, 0.5 * self.dr))  # (S, N), NaN beyond horizon
-        sea = np.isfinite(psi) & (r < first_hit[:, None])
-        psi_c = np.where(np.isfinite(psi), np.maximum(psi, 1e-3), 1.0)
-        area = phys.clutter_cell_area_m2(np.maximum(r, 0.5 * self.dr), psi_c, self.beam_eq_rad, self.cell_m)
-        sigma0 = phys.undb(phys.nrl_sigma0_db(psi_c, p.f_ghz, self.env.sea_state, p.polarisation))
-        # vertical pattern at the depression of the sea cell in the antenna frame (roll/pitch included)
+    def _sea_clutter(self, rev, t, rot, pos, azimuth, heading, antenna_h, first_hit):
+        """(S, N) sea clutter SNR (K-distributed, zero in shadow and beyond the horizon) and its texture."""
+        S, N = self.spokes, self.samples
+        p = self.p
+        # mean level: NRL sigma0 x cell area through the radar equation, linear in the antenna height about
+        # its mean over the revolution (heave, roll and pitch move it by decimetres)
+        h_mid = float(np.mean(antenna_h))
+        table = self._clutter_mean_db_table(np.array([h_mid - 0.05, h_mid + 0.05]))
+        slope = ((table[1] - table[0]) / 0.1).astype(np.float32)
+        dh = (antenna_h - h_mid).astype(np.float32)
+        mean_db = (table.mean(axis=0).astype(np.float32))[None, :] + dh[:, None] * slope[None, :]
+        # vertical pattern at the sea cell's depression in the antenna frame (roll and pitch included)
+        psi = phys.grazing_angle_deg(h_mid, self.r64)
+        psi_r = np.radians(np.where(np.isfinite(psi), np.maximum(psi, 1e-3), 1.0)).astype(np.float32)
         bearing = np.radians(azimuth)
-        dxy = np.stack([np.cos(bearing), -np.sin(bearing), np.zeros(S)], 1)  # horizontal in the sensor frame
+        dxy = np.stack([np.cos(bearing), -np.sin(bearing), np.zeros(S)], 1)  # horizontal boresight, sensor frame
         bore = np.einsum("sij,sj->si", rot, dxy)
         bh = bore[:, :2] / np.maximum(np.linalg.norm(bore[:, :2], axis=1, keepdims=True), 1e-12)
         z_ax = rot[:, :, 2]  # the antenna's up axis in the world
-        psi_r = np.radians(psi_c)
-        sin_el = (np.cos(psi_r) * (z_ax[:, 0] * bh[:, 0] + z_ax[:, 1] * bh[:, 1])[:, None]
-                  - np.sin(psi_r) * z_ax[:, 2][:, None])
-        el_ant = np.degrees(np.arcsin(np.clip(sin_el, -1.0, 1.0)))
-        clutter_open = np.where(np.isfinite(psi), phys.snr(sigma0 * area, np.maximum(r, 0.5 * self.dr), **self.snr_kw)
-                                * phys.two_way_gain(el_ant, p.beam_el_deg), 0.0)
-        clutter_mean = np.where(sea, clutter_open, 0.0)
-        rng = stream(self.seed, f"radar.clutter.{rev}")
-        if self.env.sea_state >= 0 and sea.any():
-            theta_sw = (azimuth + heading)[:, None] - self.env.wind_from_deg
-            nu = phys.ward_shape_nu(psi_c, area, p.polarisation, theta_sw)
-            texture = self._texture(rng, nu)
-            speckle = rng.standard_exponential((S, N))
-            clutter = clutter_mean * texture * speckle
-        else:
-            clutter = clutter_mean
+        sin_tilt = (z_ax[:, 0] * bh[:, 0] + z_ax[:, 1] * bh[:, 1]).astype(np.float32)
+        sin_el = np.cos(psi_r)[None, :] * sin_tilt[:, None] - np.sin(psi_r)[None, :] * z_ax[:, 2].astype(np.float32)[:, None]
+        # two-way Gaussian pattern in dB at the elevation asin(sin_el): ~ sin_el (0.5 % at 10 deg) except in the
+        # first, steep range bins
+        steep = int(np.count_nonzero(np.degrees(psi_r) > 10.0))
+        el_sq = sin_el * sin_el
+        el_sq[:, :steep] = np.arcsin(np.clip(sin_el[:, :steep], -1.0, 1.0)) ** 2
+        mean_db += np.float32(2.0 * phys.one_way_gain_db(math.degrees(1.0), p.beam_el_deg)) * el_sq
+        mean_db[self.range_m[None, :] >= first_hit[:, None]] = -300.0  # radar shadow behind the first hit
+        mean = np.power(np.float32(10.0), mean_db * np.float32(0.1))
+        if self.env.sea_state <= 0:
+            return mean, None
+        # texture: the sea's own field at the cells' world positions, averaged over the beam in azimuth. The
+        # average is smooth over a beamwidth, so it is formed on every sub-th spoke and repeated
+        beam_spokes = p.beam_az_deg / (360.0 / S)
+        sub = max(1, int(beam_spokes // 8))
+        while S % sub:
+            sub -= 1
+        rows = np.arange(0, S, sub)
+        rng32 = self.range_m[None, :]
+        east = pos[rows, 0, None].astype(np.float32) + bh[rows, 0, None].astype(np.float32) * rng32
+        north = pos[rows, 1, None].astype(np.float32) + bh[rows, 1, None].astype(np.float32) * rng32
+        z = self.texture_field.sample(east, north, float(t[S // 2]))
+        width = max(1, int(round(beam_spokes / sub)))
+        z = _box_wrap(_box_wrap(z, width), width)
+        std = np.maximum(uniform_filter1d(z.std(axis=0), 33, mode="nearest"), 1e-6)
+        z /= std[None, :]
+        # Ward's shape (REF 3.8) varies with range (grazing, cell area) and with the look direction to the swell
+        psi_c = np.where(np.isfinite(psi), np.maximum(psi, 1e-3), 1.0)
+        area = phys.clutter_cell_area_m2(self.r64, psi_c, self.beam_eq_rad, self.cell_m)
+        log_nu_r = np.log(phys.ward_shape_nu(psi_c, area, p.polarisation, 45.0))  # cos(90 deg) = 0: no swell term
+        swell = -np.cos(np.radians(2.0 * ((azimuth[rows] + heading[rows]) - self.env.wind_from_deg))) / 3.0 * math.log(10.0)
+        texture = self.gamma(z, (log_nu_r[None, :] + swell[:, None]).astype(np.float32))
+        if sub > 1:
+            texture = np.repeat(texture, sub, axis=0)
+        speckle = stream(self.seed, f"radar.clutter.{rev}").standard_exponential((S, N), dtype=np.float32)
+        return mean * texture * speckle, texture
 
-        # ---- rain: volume clutter (exponential speckle) and two-way attenuation
-        rain = 0.0
-        if self.env.rain_mm_per_h > 0:
-            rr = np.maximum(r, 0.5 * self.dr)
-            volume = rr * self.beam_eq_rad * self.cell_m * np.minimum(rr * self.el_eq_rad / 2.0, p.rain_height_m)
-            eta = phys.rain_eta_m2_per_m3(self.env.rain_mm_per_h, p.f_ghz)
-            rain = phys.snr(eta * volume, rr, **self.snr_kw) * stream(self.seed, f"radar.rain.{rev}").standard_exponential((S, N))
-        loss = phys.undb(-2.0 * self.rain_db_per_m * r)
-
-        # ---- receiver
-        noise = stream(self.seed, f"radar.noise.{rev}").standard_exponential((S, N))
-        total = (targets + clutter + rain) * loss + noise
-        p_db = phys.db(total) + phys.stc_gain_db(r, p.stc_a0_db, p.stc_n, p.stc_r0_m)
-        echo = phys.quantise(p_db, p.video_floor_db, p.video_step_db)
-        return Revolution(echo, azimuth.astype(np.float32), heading.astype(np.float32), t, self.range_m,
-                          p_db.astype(np.float32), first_hit)
-
-    def _texture(self, rng: np.random.Generator, nu: np.ndarray) -> np.ndarray:
-        """Gamma(nu, mean 1) texture correlated over range (REF 3.8 length) and one beamwidth in azimuth."""
-        S, N = nu.shape
-        white = rng.standard_normal((S, N))
-        length = phys.texture_correlation_length_m(self.env.sea_state)
-        sig_r = length / self.dr  # bins
-        sig_a = (self.p.beam_az_deg / 2.3548) / (360.0 / S)  # spokes
-        fs = np.fft.fftfreq(S)[:, None]
-        fr = np.fft.rfftfreq(N)[None, :]
-        transfer = np.exp(-2.0 * math.pi**2 * ((fs * sig_a) ** 2 + (fr * sig_r) ** 2))
-        field_ = np.fft.irfft2(np.fft.rfft2(white) * transfer, s=(S, N))
-        std = math.sqrt(float(np.sum(transfer[:, 0] ** 2) + 2.0 * np.sum(transfer[:, 1:] ** 2)) / (S * N))
-        return self.gamma(field_ / max(std, 1e-12), nu)
+    def _ftc(self, p_db: np.ndarray) -> np.ndarray:
+        """Rain control: subtract the log video's excess over the noise, low-passed along range (one-sided)."""
+        a = math.exp(-self.dr / self.p.ftc_m)
+        low = lfilter([1.0 - a], [1.0, -a], p_db, axis=1).astype(np.float32)
+        return p_db - np.maximum(low - NOISE_LOG_MEAN_DB, 0.0)
 
     def render_revolution(self, rev: int) -> dict:
         """The NPZ contract arrays of revolution ``rev`` (echo, azimuth_deg, heading_deg, time, range_m)."""

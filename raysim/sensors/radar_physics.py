@@ -131,6 +131,12 @@ def two_way_gain(theta_deg, width_3db_deg: float = BEAM_AZ_DEG):
     return np.exp(-8.0 * math.log(2.0) * t * t / (width_3db_deg * width_3db_deg))
 
 
+def one_way_gain_db(theta_deg, width_3db_deg: float):
+    """One-way power gain of a Gaussian beam in dB (peak 0): ``-4 ln2 (10 / ln 10) theta^2 / theta3^2``."""
+    t = np.asarray(theta_deg)
+    return (-40.0 * math.log(2.0) / math.log(10.0) / (width_3db_deg * width_3db_deg)) * t * t
+
+
 def two_way_equivalent_width_rad(width_3db_deg: float) -> float:
     """Integral of :func:`two_way_gain` over angle, rad: ``theta3 sqrt(pi / (8 ln 2))`` (0.753 theta3)."""
     return math.radians(width_3db_deg) * math.sqrt(math.pi / (8.0 * math.log(2.0)))
@@ -189,15 +195,20 @@ class GammaQuantiles:
         u = np.clip(ndtr(self.z)[None, :], 1e-300, 1.0 - 1e-16)
         self.table = (gammaincinv(nu, u) / nu).astype(np.float64)
         self.dz = self.z[1] - self.z[0]
+        self._table32 = self.table.reshape(-1).astype(np.float32)
 
-    def __call__(self, z: np.ndarray, nu: np.ndarray) -> np.ndarray:
-        k = np.rint((np.log(np.clip(nu, NU_MIN, NU_MAX)) - self.log_nu[0]) / (self.log_nu[1] - self.log_nu[0])).astype(np.intp)
-        pos = np.clip((z - self.z[0]) / self.dz, 0.0, self.z.size - 1.000001)
-        j = pos.astype(np.intp)
+    def __call__(self, z: np.ndarray, log_nu: np.ndarray) -> np.ndarray:
+        """Gamma(nu, mean 1) quantiles (float32) of standard-normal ``z``; ``log_nu`` is ln(shape), broadcastable."""
+        z = np.asarray(z, dtype=np.float32)
+        step = np.float32(self.log_nu[1] - self.log_nu[0])
+        k = np.rint((np.clip(log_nu, self.log_nu[0], self.log_nu[-1]) - np.float32(self.log_nu[0])) / step).astype(np.int32)
+        pos = np.clip((z - np.float32(self.z[0])) * np.float32(1.0 / self.dz), 0.0, np.float32(self.z.size - 1.001))
+        j = pos.astype(np.int32)
         frac = pos - j
-        flat = k * self.z.size + j
-        t = self.table.reshape(-1)
-        return t[flat] * (1.0 - frac) + t[flat + 1] * frac
+        flat = k * np.int32(self.z.size) + j
+        lo = self._table32.take(flat)
+        hi = self._table32.take(flat + 1)
+        return lo + (hi - lo) * frac
 
 
 # ------------------------------------------------------------------ rain (REF 3.9)
@@ -233,18 +244,133 @@ def rain_eta_m2_per_m3(rain_mm_per_h, f_ghz: float = FREQUENCY_GHZ, k2: float = 
 # ------------------------------------------------------------------ targets (REF 3.6)
 
 
-def facet_sigma_m2(reflectivity_db, cos_incidence, specular_exponent, range_m, d_az_rad, d_el_rad,
-                   diffuse_gain: float, specular_gain: float):
-    """RCS of the surface patch one ray stands for.
+def facet_sigma_m2(reflectivity_db, projected_area_m2, cos_ray, lobe_exponent, roughness_m, facet_area_m2,
+                   cos_facet, range_m, f_ghz: float = FREQUENCY_GHZ, diffuse_gain: float = 1.0):
+    """RCS of the surface patch one ray stands for: facet physical optics plus a rough-surface lobe.
 
-    The ray's footprint is ``A = R^2 d_az d_el / cos(theta)``; its backscatter
-    ``sigma = rho A cos(theta) (D cos(theta) + S cos^n(theta))`` with rho the material's power
-    reflectivity (re. metal), D a diffuse and S a specular gain (engineering defaults, unverified).
+    ``sigma = rho a [q (4 pi A_f / lambda^2) cos(theta_f) exp(-k^2 A_f sin^2(theta_f) / 3) c
+    + (1 - q) D (4 (n + 2) / 3) cos^n(theta_ray)]``
+
+    - ``a = R^2 d_az d_el``: the ray's footprint across the ray (m^2);
+    - ``rho``: the material's power reflectivity re. metal (Fresnel; ice about -11 dB);
+    - ``q = exp(-(4 pi h cos(theta_f) / lambda)^2)``: the coherent fraction of a surface of rms
+      height ``h`` (Rayleigh roughness): painted plate is mirror-like, weathered ice fully rough;
+    - coherent part, physical optics of the flat facet of area ``A_f`` the ray hit (coplanar
+      triangles, :mod:`raysim.sensors.radar_facets`), seen at the incidence ``theta_f`` of the line
+      of sight to the facet's centre: summed over the rays that cover the facet
+      (``sum a = A_f cos theta_f``) it gives ``4 pi A_f^2 cos^2 / lambda^2`` at normal incidence,
+      the flat plate's RCS (REF 3.6), falling off as the Gaussian that matches the curvature of
+      the plate's ``sinc^2`` main lobe (``sinc^2 x ~ exp(-x^2/3)``, ``x = k sqrt(A_f) sin theta``).
+      That lobe is energy-consistent: a finely tessellated sphere sums to ``3 a^2``, near its PO
+      RCS ``pi a^2``, whatever the facet size. ``c = 1 / (1 + sigma_f / (pi R^2))`` caps a facet in
+      its own near field at the mirror limit ``pi R^2`` of an infinite plane at range R;
+    - incoherent part: the material's rough-surface lobe ``cos^n``, normalised so that its
+      integral over the hemisphere equals a Lambertian surface's (``4 cos`` per projected area at
+      ``n = 1``); ``D`` scales it (1; unverified).
+
+    Parameters
+    ----------
+    reflectivity_db, projected_area_m2, cos_ray, lobe_exponent, roughness_m, facet_area_m2, cos_facet, range_m : (H,) float
+        Per hit. Cosines of the incidence angles are clipped to [0, 1].
+    f_ghz : float
+    diffuse_gain : float
+
+    Returns
+    -------
+    (H,) float64, m^2
     """
-    c = np.clip(np.asarray(cos_incidence, dtype=float), 0.0, 1.0)
-    rho = undb(reflectivity_db)
-    projected = np.asarray(range_m, dtype=float) ** 2 * d_az_rad * d_el_rad
-    return rho * projected * (diffuse_gain * c + specular_gain * np.power(c, specular_exponent))
+    lam = wavelength_m(f_ghz)
+    k2 = (2.0 * math.pi / lam) ** 2
+    c_ray = np.clip(np.asarray(cos_ray, dtype=float), 0.0, 1.0)
+    c_f = np.clip(np.asarray(cos_facet, dtype=float), 0.0, 1.0)
+    n = np.asarray(lobe_exponent, dtype=float)
+    area_f = np.asarray(facet_area_m2, dtype=float)
+    q = np.exp(-(4.0 * math.pi * np.asarray(roughness_m, dtype=float) * c_f / lam) ** 2)
+    lobe = np.exp(-k2 * area_f * (1.0 - c_f * c_f) / 3.0)
+    sigma_facet = 4.0 * math.pi * area_f**2 * c_f * c_f / lam**2 * lobe
+    cap = 1.0 / (1.0 + sigma_facet / (math.pi * np.asarray(range_m, dtype=float) ** 2))
+    coherent = 4.0 * math.pi * area_f / lam**2 * c_f * lobe * cap
+    incoherent = diffuse_gain * (4.0 * (n + 2.0) / 3.0) * np.power(c_ray, n)
+    return undb(reflectivity_db) * np.asarray(projected_area_m2, dtype=float) * (q * coherent + (1.0 - q) * incoherent)
+
+
+def flat_plate_rcs_m2(area_m2: float, f_ghz: float = FREQUENCY_GHZ) -> float:
+    """Normal-incidence RCS of a flat conducting plate, ``4 pi A^2 / lambda^2`` (REF 3.6)."""
+    return 4.0 * math.pi * area_m2**2 / wavelength_m(f_ghz) ** 2
+
+
+# ------------------------------------------------------------------ multipath (REF 3.5)
+
+# Significant wave height of each Douglas sea state 0..6, m: the middle of the WMO code 3700 bands
+# (0, 0-0.1, 0.1-0.5, 0.5-1.25, 1.25-2.5, 2.5-4, 4-6 m); rms surface height = Hs / 4.
+SEA_STATE_HS_M = (0.0, 0.05, 0.3, 0.875, 1.875, 3.25, 5.0)
+
+
+def ament_factor(sea_state: int, sin_grazing, f_ghz: float = FREQUENCY_GHZ):
+    """Roughness reduction of the sea's specular reflection: ``exp(-2 (2 pi sigma_h sin psi / lambda)^2)`` (REF 3.5)."""
+    sigma_h = SEA_STATE_HS_M[int(np.clip(sea_state, 0, 6))] / 4.0
+    x = 2.0 * math.pi * sigma_h * np.asarray(sin_grazing, dtype=float) / wavelength_m(f_ghz)
+    return np.exp(-2.0 * x * x)
+
+
+def multipath_f4(antenna_height_m, target_height_m, range_m, sea_state: int = 0, f_ghz: float = FREQUENCY_GHZ):
+    """Two-way pattern-propagation factor ``F^4`` of the two-ray model over the sea (REF 3.5).
+
+    ``F^2 = 1 + rho^2 - 2 rho cos(4 pi ha ht / (lambda R))`` with the reflection coefficient
+    ``-rho`` (near -1 at low grazing) and ``rho`` the Ament roughness factor at the specular
+    point's grazing angle ``(ha + ht) / R``; with ``rho = 1``: ``F^4 = 16 sin^4(2 pi ha ht/(lambda R))``.
+    Heights are above the sea (a target at or below the waterline gets ``(1 - rho)^4``).
+    """
+    ha = np.maximum(np.asarray(antenna_height_m, dtype=float), 0.0)
+    ht = np.maximum(np.asarray(target_height_m, dtype=float), 0.0)
+    r = np.maximum(np.asarray(range_m, dtype=float), 1e-3)
+    rho = ament_factor(sea_state, np.minimum((ha + ht) / r, 1.0), f_ghz)
+    f2 = 1.0 + rho * rho - 2.0 * rho * np.cos(4.0 * math.pi * ha * ht / (wavelength_m(f_ghz) * r))
+    return f2 * f2
+
+
+# ------------------------------------------------------------------ ray fan
+
+
+def elevation_grid_rad(antenna_height_m: float, resolve_range_m: float, resolve_m: float, top_height_m: float,
+                       low_height_m: float, el_max_deg: float, el_min_deg: float) -> tuple[np.ndarray, np.ndarray]:
+    """Elevation angles of a spoke's rays (antenna frame, descending) and the extent each stands for.
+
+    - At and above the horizon the spacing at elevation ``e`` is ``max(s0, e s / (H - ha))`` with
+      ``s0 = resolve_m / resolve_range_m``: rays at most ``resolve_m`` apart at the resolve range,
+      and since an object no taller than ``H = top_height_m`` seen at ``e`` is nearer than
+      ``(H - ha) / tan e``, at most ``resolve_m`` apart on it wherever it stands.
+    - Below the horizon the rays meet the flat sea at distances ``d_1 > d_2 > ...`` from
+      ``1.5 resolve_range_m`` inwards with ``d_i / d_(i+1) = ha / (ha - low_height_m)``: at any
+      distance some ray passes between the waterline and ``low_height_m`` (a buoy or a growler that
+      low is hit wherever it floats), down to ``el_min_deg``.
+
+    Returns
+    -------
+    el_rad : (K,) float64
+    d_el_rad : (K,) float64
+    """
+    ha = max(float(antenna_height_m), 0.1)
+    s0 = resolve_m / max(float(resolve_range_m), 1.0)
+    up_ratio = resolve_m / max(top_height_m - ha, resolve_m)
+    e_max, e_min = math.radians(el_max_deg), math.radians(el_min_deg)
+    up, e = [], 0.0
+    while e < e_max:
+        e += max(s0, e * up_ratio)
+        up.append(min(e, e_max))
+    shrink = max(ha - min(low_height_m, 0.9 * ha), 1e-3) / ha  # d_(i+1) / d_i
+    down, d = [], 1.5 * max(float(resolve_range_m), 1.0)
+    while True:
+        e = -math.atan2(ha, d)
+        if e <= e_min:
+            down.append(e_min)
+            break
+        down.append(e)
+        d *= shrink
+    el = np.array(up[::-1] + [0.0] + down)
+    edges = np.concatenate([[el[0] + 0.5 * (el[0] - el[1])], 0.5 * (el[1:] + el[:-1]),
+                            [el[-1] - 0.5 * (el[-2] - el[-1])]])
+    return el, edges[:-1] - edges[1:]
 
 
 # ------------------------------------------------------------------ receiver (REF 3.10)

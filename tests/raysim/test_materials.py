@@ -115,6 +115,7 @@ def test_table_arrays_aligned_with_materials():
         "retroreflective": np.bool_,
         "radar_reflectivity_db": np.float32,
         "specular_exponent": np.float32,
+        "radar_roughness_m": np.float32,
     }
     assert set(table) == set(expected_dtypes)
     for key, dtype in expected_dtypes.items():

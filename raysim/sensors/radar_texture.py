@@ -1,0 +1,104 @@
+"""Sea-clutter texture fixed to the sea surface: correlated in space and time, moving with the waves.
+
+The compound K model (REF 3.8) writes clutter intensity as texture x speckle. The texture is the
+local power of the sea's scatterers (wave fronts, breaking crests): it belongs to the sea, not to
+the radar. Here it is a stationary Gaussian random field on a periodic world-fixed tile:
+
+- space: Gaussian correlation with the REF 3.8 length ``(pi/2)(W^2/g) sqrt(3 cos^2(A) + 1)``,
+  twice as long along the wind (A = 0) as across it, with W the sea state's wind (REF 3.8 table);
+- motion: the tile drifts downwind at W, the phase speed of waves of that correlation length
+  (``c = sqrt(g L / (2 pi))`` with ``L = 2 pi W^2 / g`` gives ``c = W``);
+- time: key frames ``T = 2 pi W / g`` apart (the period of those waves; "correlated over
+  seconds", REF 3.8; engineering choice, unverified), blended as ``cos(pi u/2) F_k + sin(pi u/2) F_k+1``
+  so the field keeps unit variance and decorrelates over one key interval.
+
+Each key frame comes from its own named random stream (``radar.texture.<k>``), so any
+revolution renders the same without the ones before it.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import scipy.fft
+
+from raysim.random_streams import stream
+from raysim.sensors import radar_physics as phys
+
+__all__ = ["SeaTexture"]
+
+
+class SeaTexture:
+    """Unit-variance Gaussian sea texture at world points and times.
+
+    Parameters
+    ----------
+    seed : int
+        The scenario seed.
+    sea_state : int
+        Douglas sea state 0..6 (sets the wind W of the correlation length, drift and key interval).
+    wind_from_deg : float
+        Direction the wind comes from, degrees clockwise from north; waves travel the other way.
+    tile_cells : int
+        Tile size in cells each way (a power of two; the tile repeats beyond it).
+    """
+
+    def __init__(self, seed: int, sea_state: int, wind_from_deg: float, tile_cells: int = 1024):
+        w = phys.TEXTURE_WIND_MPS[int(np.clip(sea_state, 0, 6))]
+        base = (math.pi / 2.0) * w * w / phys.G_MPS2
+        self.length_along_m, self.length_across_m = 2.0 * base, base  # sqrt(3 cos^2 A + 1) at A = 0, 90 deg
+        self.cell_m = self.length_across_m / 2.0
+        self.n = int(tile_cells)
+        if self.n & (self.n - 1):
+            raise ValueError(f"tile_cells must be a power of two, got {tile_cells}")
+        self.seed = int(seed)
+        to_rad = math.radians(wind_from_deg + 180.0)  # direction the waves travel, clockwise from north
+        self.down_wind = np.array([math.sin(to_rad), math.cos(to_rad)])  # east, north
+        self.drift_mps = w
+        self.key_s = 2.0 * math.pi * w / phys.G_MPS2
+        # spectral filter: Gaussian correlation exp(-d^2 / (2 L^2)) has the power spectrum of a Gaussian
+        # kernel of standard deviation L / sqrt(2) in each principal direction
+        f = np.fft.fftfreq(self.n, d=self.cell_m)
+        fx, fy = np.meshgrid(f, np.fft.rfftfreq(self.n, d=self.cell_m), indexing="ij")
+        along = fx * self.down_wind[0] + fy * self.down_wind[1]
+        across = -fx * self.down_wind[1] + fy * self.down_wind[0]
+        sa, sc = self.length_along_m / math.sqrt(2.0), self.length_across_m / math.sqrt(2.0)
+        self._transfer = np.exp(-2.0 * math.pi**2 * ((along * sa) ** 2 + (across * sc) ** 2)).astype(np.float32)
+        self._keys: dict[int, np.ndarray] = {}
+
+    def _key(self, k: int) -> np.ndarray:
+        if k not in self._keys:
+            if len(self._keys) > 3:
+                self._keys.pop(min(self._keys))
+            white = stream(self.seed, f"radar.texture.{k}").standard_normal((self.n, self.n), dtype=np.float32)
+            field = scipy.fft.irfft2(scipy.fft.rfft2(white) * self._transfer, s=(self.n, self.n))
+            self._keys[k] = (field / field.std()).astype(np.float32).reshape(-1)
+        return self._keys[k]
+
+    def sample(self, east_m: np.ndarray, north_m: np.ndarray, time_s: float) -> np.ndarray:
+        """Texture (standard normal, correlated) at world points, one time for all of them.
+
+        Parameters
+        ----------
+        east_m, north_m : (...) float
+            Local ENU position of the sea cells, m.
+        time_s : float
+            Scenario time (one per revolution: the texture changes over seconds, a revolution lasts 2.5 s).
+
+        Returns
+        -------
+        (...) float32
+        """
+        u = time_s / self.key_s
+        k = int(math.floor(u))
+        frac = u - k
+        shift = self.drift_mps * time_s * self.down_wind
+        mask = self.n - 1  # the tile repeats: index modulo n (a power of two) by masking
+        i = np.floor((east_m - shift[0]) * (1.0 / self.cell_m)).astype(np.int64) & mask
+        j = np.floor((north_m - shift[1]) * (1.0 / self.cell_m)).astype(np.int64) & mask
+        flat = i * self.n + j
+        a = self._key(k).take(flat)
+        b = self._key(k + 1).take(flat)
+        ca, cb = math.cos(0.5 * math.pi * frac), math.sin(0.5 * math.pi * frac)
+        return (ca * a + cb * b).astype(np.float32, copy=False)
