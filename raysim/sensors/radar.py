@@ -129,6 +129,7 @@ class Revolution:
     first_hit_m: np.ndarray = field(repr=False, default=None)  # (S,) first object hit (inf: none)
     target_snr: np.ndarray = field(repr=False, default=None)  # (S, N) float32, object echoes alone (linear, re. noise)
     texture: np.ndarray = field(repr=False, default=None)  # (S, N) float32, clutter texture (mean 1) or None
+    clutter: np.ndarray = field(repr=False, default=None)  # (S, N) float32, sea clutter alone (linear, re. noise)
 
     def arrays(self) -> dict:
         return {"echo": self.echo, "azimuth_deg": self.azimuth_deg, "heading_deg": self.heading_deg,
@@ -272,7 +273,7 @@ class RadarRenderer:
         echo = phys.quantise(p_db, p.video_floor_db, p.video_step_db)
         echo[:, : self.blank] = 0
         return Revolution(echo, azimuth.astype(np.float32), heading.astype(np.float32), t, self.range_m,
-                          p_db, first_hit, targets, texture)
+                          p_db, first_hit, targets, texture, clutter)
 
     def _targets(self, hits, on_carrier, t, o_w, d_w, antenna_h):
         """(S, N) object echoes (SNR, linear; None if no object is hit) and the first hit range per spoke."""
@@ -384,10 +385,18 @@ class RadarRenderer:
         return mean * texture * speckle, texture
 
     def _ftc(self, p_db: np.ndarray) -> np.ndarray:
-        """Rain control: subtract the log video's excess over the noise, low-passed along range (one-sided)."""
+        """Rain control (FTC): subtract the log video's excess over the noise, low-passed along range (one-sided).
+
+        A range high-pass as the analogue FTC differentiator: extended echoes (rain) fall to the noise
+        level, the leading edges of short ones (boats, buoys, land edges) stay.
+        """
         a = math.exp(-self.dr / self.p.ftc_m)
         low = lfilter([1.0 - a], [1.0, -a], p_db, axis=1).astype(np.float32)
-        return p_db - np.maximum(low - NOISE_LOG_MEAN_DB, 0.0)
+        # the reference trails by a guard of about one range resolution, so an echo's leading edge keeps its level
+        guard = int(math.ceil(self.p.range_resolution_m / self.dr)) + 1
+        ref = np.full_like(low, NOISE_LOG_MEAN_DB)
+        ref[:, guard:] = low[:, :-guard]
+        return p_db - np.maximum(ref - NOISE_LOG_MEAN_DB, 0.0)
 
     def render_revolution(self, rev: int) -> dict:
         """The NPZ contract arrays of revolution ``rev`` (echo, azimuth_deg, heading_deg, time, range_m)."""

@@ -343,7 +343,8 @@ def elevation_grid_rad(antenna_height_m: float, resolve_range_m: float, resolve_
     - Below the horizon the rays meet the flat sea at distances ``d_1 > d_2 > ...`` from
       ``1.5 resolve_range_m`` inwards with ``d_i / d_(i+1) = ha / (ha - low_height_m)``: at any
       distance some ray passes between the waterline and ``low_height_m`` (a buoy or a growler that
-      low is hit wherever it floats), down to ``el_min_deg``.
+      low is hit wherever it floats), down to ``el_min_deg``; never more than ``max(s0, |e| resolve_m / ha)``
+      apart (``resolve_m`` at the distance where the ray meets the sea).
 
     Returns
     -------
@@ -359,14 +360,13 @@ def elevation_grid_rad(antenna_height_m: float, resolve_range_m: float, resolve_
         e += max(s0, e * up_ratio)
         up.append(min(e, e_max))
     shrink = max(ha - min(low_height_m, 0.9 * ha), 1e-3) / ha  # d_(i+1) / d_i
-    down, d = [], 1.5 * max(float(resolve_range_m), 1.0)
-    while True:
-        e = -math.atan2(ha, d)
-        if e <= e_min:
-            down.append(e_min)
-            break
+    down, e, d = [], 0.0, 1.5 * max(float(resolve_range_m), 1.0)
+    while e > e_min:
+        while -math.atan2(ha, d) >= e:  # the next sea-going ray below e
+            d *= shrink
+        # ... or nearer: never more than max(s0, |e| resolve_m / ha) apart (resolve_m at the ray's sea distance)
+        e = max(e - max(s0, -e * resolve_m / ha), -math.atan2(ha, d), e_min)
         down.append(e)
-        d *= shrink
     el = np.array(up[::-1] + [0.0] + down)
     edges = np.concatenate([[el[0] + 0.5 * (el[0] - el[1])], 0.5 * (el[1:] + el[:-1]),
                             [el[-1] - 0.5 * (el[-2] - el[-1])]])

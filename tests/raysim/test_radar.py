@@ -215,3 +215,196 @@ def test_a_low_wide_target_beyond_the_horizon_is_visible_only_on_a_flat_earth(tm
         peaks[curved] = int(r.render_revolution(0)["echo"][around(0.0, 3)][:, bins].max())
     assert peaks[False] >= 4
     assert peaks[True] <= 1
+
+
+# ---------------------------------------------------------------- calibration against analytic RCS (REF 3.6)
+
+FINE = dict(resolve_m=0.15, elevation_max_deg=1.0, elevation_min_deg=-2.0, stc_a0_db=0.0, blanking_m=0.0)
+
+
+def fine_renderer(tmp_path, obstacles, name, **params):
+    from raysim.sensors.radar import RadarParams
+
+    renderer, _ = radar_world(tmp_path, obstacles=obstacles, environment={"sea_state": 0, "wind_speed_mps": 0},
+                              name=name, range_m=200.0)
+    return RadarRenderer(renderer.world, renderer.scene, RadarParams(**{**FINE, **params}))
+
+
+def peak_target_db(renderer, bearing_deg=0.0):
+    rev = renderer.revolution(0)
+    window = rev.target_snr[around(bearing_deg, 3)]
+    j = int(np.argmax(window.max(axis=0)))
+    return 10.0 * np.log10(float(window.max())), float(renderer.range_m[j])
+
+
+def plate(tmp_path, name, width_m, height_m, distance_m, centre_z_m, yaw_deg=0.0, material="steel_painted"):
+    mesh = box_file(tmp_path, name, (width_m, 0.05, height_m), (0.0, 0.0, centre_z_m))
+    return {"name": name, "kind": "mesh", "mesh": mesh, "material": material, "position": latlon(0.0, distance_m),
+            "heading_deg": 90.0 + yaw_deg}  # body x across the line of sight: the face looks at the radar
+
+
+def test_a_flat_plate_facing_the_radar_returns_its_analytic_rcs(tmp_path):
+    from raysim.sensors import radar_physics as rp
+
+    r = fine_renderer(tmp_path, [plate(tmp_path, "plate", 0.5, 0.5, 150.0, 4.0)], "plate", multipath=False)
+    got_db, at_m = peak_target_db(r)
+    expected_db = rp.snr_db(rp.flat_plate_rcs_m2(0.25), at_m)  # 4 pi A^2 / lambda^2 = 771 m^2 (28.9 dBsm)
+    assert abs(at_m - 149.975) < 2 * r.dr
+    assert got_db == pytest.approx(float(expected_db), abs=1.0)
+
+
+def test_a_plate_turned_off_normal_falls_as_its_main_lobe(tmp_path):
+    from raysim.sensors import radar_physics as rp
+
+    faces = fine_renderer(tmp_path, [plate(tmp_path, "faces", 0.5, 0.5, 150.0, 4.0)], "faces", multipath=False)
+    turned = fine_renderer(tmp_path, [plate(tmp_path, "turned", 0.5, 0.5, 150.0, 4.0, yaw_deg=0.75)], "turned",
+                           multipath=False)
+    # sinc^2(k L sin 0.75 deg) for L = 0.5 m: -2.6 dB (the model's Gaussian main lobe: -2.4 dB)
+    x = 2 * np.pi / rp.wavelength_m() * 0.5 * np.sin(np.radians(0.75))
+    drop_db = peak_target_db(turned)[0] - peak_target_db(faces)[0]
+    assert drop_db == pytest.approx(10 * np.log10((np.sin(x) / x) ** 2), abs=0.7)
+
+
+def test_a_metal_sphere_returns_pi_a_squared_whatever_its_tessellation(tmp_path):
+    import trimesh
+
+    from raysim.sensors import radar_physics as rp
+
+    for subdivisions in (3, 4):
+        mesh = trimesh.creation.icosphere(subdivisions=subdivisions, radius=1.0)
+        mesh.apply_translation((0.0, 0.0, 4.0))
+        mesh.export(tmp_path / f"sphere{subdivisions}.stl")
+        sphere = {"name": "sphere", "kind": "mesh", "mesh": f"sphere{subdivisions}.stl", "material": "steel_painted",
+                  "position": latlon(0.0, 150.0), "heading_deg": 0.0}
+        r = fine_renderer(tmp_path, [sphere], f"sphere{subdivisions}", multipath=False)
+        got_db, at_m = peak_target_db(r)
+        # the sphere's echo spreads over ~1 m of range; the model's range point-spread (2.5 m) gathers it
+        assert got_db == pytest.approx(float(rp.snr_db(np.pi * 1.0**2, at_m)), abs=2.0), subdivisions
+
+
+def test_multipath_over_a_calm_sea_averages_six_over_a_lobe_and_nulls_the_waterline(tmp_path):
+    # two-ray over a mirror sea (REF 3.5): F^4 = 16 sin^4(2 pi ha ht / (lambda R)); ha 4 m, R 150 m: one lobe per
+    # 0.6 m of target height. Averaged over a whole lobe F^4 = 6 (+7.8 dB); near the waterline F^4 -> 0
+    from raysim.sensors import radar_physics as rp
+
+    period_m = rp.wavelength_m() * 150.0 / (2 * 4.0)
+    cases = {"lobe": (period_m, period_m), "waterline": (0.15, 0.075)}
+    gains = {}
+    for key, (height, centre) in cases.items():
+        obstacle = [plate(tmp_path, key, 3.0, height, 150.0, centre)]
+        on = fine_renderer(tmp_path, obstacle, key + "on", multipath=True)
+        off = fine_renderer(tmp_path, obstacle, key + "off", multipath=False)
+        gains[key] = peak_target_db(on)[0] - peak_target_db(off)[0]
+    assert gains["lobe"] == pytest.approx(10 * np.log10(6.0), abs=1.5)
+    assert gains["waterline"] < -10.0
+    assert rp.multipath_f4(4.0, 0.3, 150.0) == pytest.approx(16 * np.sin(2 * np.pi * 4 * 0.3 / (rp.wavelength_m() * 150)) ** 4, rel=1e-6)
+
+
+# ---------------------------------------------------------------- clutter texture and speckle (REF 3.8)
+
+
+def test_rendered_clutter_is_k_distributed_with_wards_shape(tmp_path):
+    from scipy.special import gammainc
+
+    from raysim.sensors import radar_physics as rp
+
+    r, _ = radar_world(tmp_path, environment={"sea_state": 4, "wind_speed_mps": 12, "wind_from_deg": 0.0}, name="k")
+    rev = r.revolution(0)
+    band = (r.range_m > 300) & (r.range_m < 1500)
+    # texture: Gamma(nu) with Ward's nu of each cell (range through grazing and cell area, azimuth through the swell)
+    psi = rp.grazing_angle_deg(4.0, r.range_m[band].astype(float))
+    area = rp.clutter_cell_area_m2(r.range_m[band], psi, r.beam_eq_rad, r.cell_m)
+    theta = np.arange(SPOKES) * 360.0 / SPOKES
+    nu = rp.ward_shape_nu(psi[None, :], area[None, :], "HH", theta[:, None] - 0.0)
+    u = gammainc(nu, nu * rev.texture[:, band])  # probability integral transform: uniform if Gamma(nu)
+    assert np.quantile(u, [0.1, 0.5, 0.9]) == pytest.approx([0.1, 0.5, 0.9], abs=0.05)
+    assert rev.texture[:, band].mean() == pytest.approx(1.0, abs=0.1)
+    # speckle: given the texture, the intensity is exponential (second moment twice the squared mean)
+    x = rev.clutter[:, band] / rev.texture[:, band]
+    x = x / x.mean(axis=0, keepdims=True)
+    assert np.mean(x * x) == pytest.approx(2.0, rel=0.05)
+
+
+def test_texture_is_correlated_in_time_speckle_is_not(tmp_path):
+    r, _ = radar_world(tmp_path, environment={"sea_state": 4, "wind_speed_mps": 12}, name="t")
+    band = (r.range_m > 200) & (r.range_m < 1000)
+    revs = {k: r.revolution(k) for k in (0, 1, 12)}
+
+    def corr(a, b):  # of the log, each range bin's mean removed (the mean clutter level falls with range)
+        la, lb = np.log(a[:, band]), np.log(b[:, band])
+        la, lb = la - la.mean(axis=0), lb - lb.mean(axis=0)
+        return float(np.corrcoef(la.ravel(), lb.ravel())[0, 1])
+
+    assert corr(revs[0].texture, revs[1].texture) > 0.5  # 2.5 s apart: the same waves, moved on a little
+    assert abs(corr(revs[0].texture, revs[12].texture)) < 0.15  # 30 s apart: new waves
+    speckle0 = revs[0].clutter / revs[0].texture
+    speckle1 = revs[1].clutter / revs[1].texture
+    assert abs(corr(speckle0, speckle1)) < 0.05  # fresh speckle every spoke
+
+
+def test_sea_texture_drifts_downwind_with_the_waves():
+    from raysim.sensors.radar_texture import SeaTexture
+
+    tex = SeaTexture(seed=5, sea_state=4, wind_from_deg=270.0)  # waves travel east
+    e, n = np.meshgrid(np.arange(0.0, 400.0, 2.0), np.arange(0.0, 400.0, 2.0))
+    dt = 0.6 * tex.key_s
+    now = tex.sample(e, n, 10.0)
+    moved = tex.sample(e + tex.drift_mps * dt, n, 10.0 + dt)  # follow the waves
+    still = tex.sample(e, n, 10.0 + dt)  # stay put
+    c_moved = np.corrcoef(now.ravel(), moved.ravel())[0, 1]
+    c_still = np.corrcoef(now.ravel(), still.ravel())[0, 1]
+    assert c_moved > 0.55 and c_moved > c_still + 0.2
+    assert now.std() == pytest.approx(1.0, abs=0.1)
+
+
+# ---------------------------------------------------------------- receiver controls and scenario keys (REF 3.10)
+
+
+def test_rain_control_clears_rain_haze_and_keeps_a_point_target(tmp_path):
+    from raysim.sensors.radar import RadarParams
+
+    target = hull(tmp_path, "boat", 90.0, 800.0, length=6.0, height=2.0)
+    base, _ = radar_world(tmp_path, obstacles=[target], environment={"sea_state": 0, "wind_speed_mps": 0,
+                                                                      "rain_mm_per_h": 16.0}, name="ftc")
+    haze, echo = {}, {}
+    for ftc in (0.0, 20.0):
+        r = RadarRenderer(base.world, base.scene, RadarParams(ftc_m=ftc))
+        e = r.render_revolution(0)["echo"]
+        rain_only = (r.range_m > 300) & (r.range_m < 700)
+        haze[ftc] = float((e[:, rain_only] > 0).mean())
+        echo[ftc] = int(e[around(90.0, 2)][:, int(780 / r.dr): int(820 / r.dr)].max())
+    assert haze[0.0] > 0.3  # 16 mm/h rain paints a hazy disc
+    assert haze[20.0] < 0.2 * haze[0.0]
+    assert echo[20.0] >= 6 and echo[20.0] >= echo[0.0] - 4
+
+
+def test_main_bang_blanking_zeroes_the_first_samples(tmp_path):
+    from raysim.sensors.radar import RadarParams
+
+    base, _ = radar_world(tmp_path, environment={"sea_state": 5, "wind_speed_mps": 14}, name="mbb")
+    for blanking in (0.0, 30.0):
+        r = RadarRenderer(base.world, base.scene, RadarParams(stc_a0_db=0.0, blanking_m=blanking))
+        e = r.render_revolution(0)["echo"]
+        near = r.range_m < 30.0
+        if blanking:
+            assert e[:, near].max() == 0 and e[:, ~near][:, :5].max() > 0
+        else:
+            assert e[:, near][:, 1:].max() > 0
+
+
+def test_scenario_keys_set_the_radar_model(tmp_path):
+    data = scenario(tmp_path, duration=3.0)
+    data["sensors"] = {"lidar": {"enabled": False},
+                       "radar": {"spokes": 256, "samples": 256, "polarisation": "VV", "multipath": False,
+                                 "earth_curvature": False, "sea_clutter_control_db": 0, "rain_clutter_control_m": 15,
+                                 "blanking_m": 10, "beam_az_deg": 4.0, "beam_el_deg": 20.0, "resolve_m": 8.0}}
+    path = tmp_path / "keys.yaml"
+    path.write_text(yaml.safe_dump(data))
+    world = World(load_scenario(path))
+    r = RadarRenderer(world, CarrierScene(world.scene_objects(), sea_material=material_index("sea")))
+    assert (r.p.polarisation, r.p.multipath, r.p.earth_curvature, r.p.stc_a0_db, r.p.ftc_m, r.p.blanking_m,
+            r.p.beam_az_deg, r.p.beam_el_deg, r.p.resolve_m) == ("VV", False, False, 0.0, 15.0, 10.0, 4.0, 20.0, 8.0)
+    data["sensors"]["radar"]["sea_clutter_contol_db"] = 3
+    path.write_text(yaml.safe_dump(data))
+    assert main(["render", str(path), "-o", str(tmp_path / "out")]) == 2
+    assert not (tmp_path / "out").exists()
