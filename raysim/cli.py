@@ -156,7 +156,7 @@ def cmd_import_hilsim(args) -> int:
     return 0
 
 
-BENCHMARKS = ("ray_engine", "lidar")
+BENCHMARKS = ("ray_engine", "lidar", "radar")
 
 
 def cmd_bench(args) -> int:

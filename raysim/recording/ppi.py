@@ -7,6 +7,7 @@ a heading line, video levels 0..15 as phosphor green on black.
 
 from __future__ import annotations
 
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -15,6 +16,26 @@ from PIL import Image, ImageDraw
 from raysim.recording.staging import atomic_path
 
 SIZE_PX = 800
+
+
+#: phosphor green: video level 0..15 -> RGB
+PALETTE = np.array([[40 * v, 40 + 215 * v, 20 + 60 * v] for v in np.arange(16) / 15.0]).astype(np.uint8)
+BEARING_BINS = 7200  # 0.05 deg: finer than the finest spoke spacing drawn (8192 spokes: 0.044 deg ~ one bin)
+
+
+@lru_cache(maxsize=4)
+def _pixel_geometry(size_px: int, samples: int, range_scale_m: float):
+    """Per pixel (flattened): bearing bin, sample index, inside the range scale (cached per display)."""
+    half = size_px / 2.0
+    y, x = np.mgrid[0:size_px, 0:size_px]
+    dx, dy = x - half + 0.5, half - y - 0.5
+    radius = np.hypot(dx, dy) / half * range_scale_m
+    bearing = np.degrees(np.arctan2(dx, dy)) % 360.0
+    bins = (np.floor(bearing / 360.0 * BEARING_BINS).astype(np.int64) % BEARING_BINS).ravel()
+    range_m = np.arange(samples) * (range_scale_m / (samples - 1))
+    sample = np.clip(np.searchsorted(range_m, radius), 0, samples - 1).ravel()
+    inside = (radius <= range_scale_m).ravel()
+    return bins, sample, inside
 
 
 def ppi_image(echo: np.ndarray, azimuth_deg: np.ndarray, heading_deg: np.ndarray, range_m: np.ndarray,
@@ -28,24 +49,20 @@ def ppi_image(echo: np.ndarray, azimuth_deg: np.ndarray, heading_deg: np.ndarray
     azimuth_deg, heading_deg : (S,) float
         Antenna azimuth from the bow and own-ship heading of each spoke, degrees.
     range_m : (N,) float
-        Range of each sample.
+        Range of each sample (first at the antenna, last at the range scale, evenly spaced).
     """
     spokes, samples = echo.shape
     half = size_px / 2.0
-    y, x = np.mgrid[0:size_px, 0:size_px]
-    dx, dy = x - half + 0.5, half - y - 0.5
-    radius = np.hypot(dx, dy) / half * range_m[-1]
-    bearing = np.degrees(np.arctan2(dx, dy)) % 360.0
-    # the spoke whose true bearing is nearest each pixel's bearing
-    true = (heading_deg + azimuth_deg) % 360.0
-    order = np.argsort(true)
-    pos = np.searchsorted(true[order], bearing) % spokes
-    spoke = order[pos]
-    sample = np.clip(np.searchsorted(range_m, radius), 0, samples - 1)
-    level = np.where(radius <= range_m[-1], echo[spoke, sample], 0).astype(np.float64) / 15.0
-    rgb = np.stack([40 * level, 40 + 215 * level, 20 + 60 * level], axis=-1)
-    rgb[radius > range_m[-1]] = 0
-    image = Image.fromarray(rgb.astype(np.uint8))
+    bins, sample, inside = _pixel_geometry(size_px, samples, float(range_m[-1]))
+    # the spoke whose true bearing is nearest (at or after) each bearing bin's centre
+    true = (np.asarray(heading_deg, dtype=float) + azimuth_deg) % 360.0
+    order = np.argsort(true, kind="stable")
+    centres = (np.arange(BEARING_BINS) + 0.5) * (360.0 / BEARING_BINS)
+    spoke_of_bin = order[np.searchsorted(true[order], centres) % spokes]
+    level = np.where(inside, echo[spoke_of_bin[bins], sample], 0)
+    rgb = PALETTE[level]
+    rgb[~inside] = 0
+    image = Image.fromarray(rgb.reshape(size_px, size_px, 3))
     draw = ImageDraw.Draw(image)
     for quarter in (1, 2, 3, 4):
         r = half * quarter / 4
@@ -61,4 +78,4 @@ def write_ppi(path: Path, sweep: dict[str, np.ndarray]) -> None:
     """Write the PPI picture of a sweep (the NPZ arrays) as PNG, atomically."""
     image = ppi_image(sweep["echo"], sweep["azimuth_deg"], sweep["heading_deg"], sweep["range_m"])
     with atomic_path(Path(path)) as tmp:
-        image.save(tmp, format="PNG", optimize=False)
+        image.save(tmp, format="PNG", optimize=False, compress_level=3)

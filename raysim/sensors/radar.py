@@ -105,17 +105,6 @@ class RadarParams:
                    resolve_m=cfg.resolve_m)
 
 
-def _box_wrap(x: np.ndarray, width: int) -> np.ndarray:
-    """Moving average of ``width`` rows along axis 0, circular (azimuth wraps), by cumulative sums."""
-    if width <= 1:
-        return x
-    left = width // 2
-    padded = np.concatenate([x[-left:] if left else x[:0], x, x[: width - left]], axis=0)
-    c = np.cumsum(padded, axis=0, dtype=np.float64)
-    out = (c[width:] - c[:-width]) * (1.0 / width)
-    return out[: x.shape[0]].astype(np.float32)
-
-
 @dataclass
 class Revolution:
     """One revolution: the NPZ contract arrays and diagnostics."""
@@ -266,7 +255,9 @@ class RadarRenderer:
             total = total + targets
         if self.rain_mean is not None:
             total = total + self.rain_mean[None, :] * stream(self.seed, f"radar.rain.{rev}").standard_exponential((S, N), dtype=np.float32)
-        total = total * self.rain_loss[None, :] + stream(self.seed, f"radar.noise.{rev}").standard_exponential((S, N), dtype=np.float32)
+        if self.env.rain_mm_per_h > 0:
+            total = total * self.rain_loss[None, :]
+        total = total + stream(self.seed, f"radar.noise.{rev}").standard_exponential((S, N), dtype=np.float32)
         p_db = 10.0 * np.log10(total, dtype=np.float32) + self.stc_db[None, :]
         if p.ftc_m > 0:
             p_db = self._ftc(p_db)
@@ -328,24 +319,35 @@ class RadarRenderer:
         return targets.astype(np.float32), first_hit
 
     def _sea_clutter(self, rev, t, rot, pos, azimuth, heading, antenna_h, first_hit):
-        """(S, N) sea clutter SNR (K-distributed, zero in shadow and beyond the horizon) and its texture."""
+        """(S, N) sea clutter SNR (K-distributed, zero in shadow and beyond the horizon) and its texture.
+
+        The mean level and the texture change smoothly over a beamwidth of spokes (the antenna's tilt and
+        height follow the ship's motion over seconds; the texture is averaged over the beam), so both are
+        formed on every ``sub``-th spoke and repeated; the speckle and the shadow are per spoke.
+        """
         S, N = self.spokes, self.samples
         p = self.p
+        beam_spokes = p.beam_az_deg / (360.0 / S)
+        sub = max(1, int(beam_spokes // 6))  # 4 at 2048 spokes and 5.2 deg: 0.7 deg steps in a 5.2 deg beam
+        while S % sub:
+            sub -= 1
+        rows = np.arange(0, S, sub)
+        h_rows = antenna_h[rows]
         # mean level: NRL sigma0 x cell area through the radar equation, linear in the antenna height about
         # its mean over the revolution (heave, roll and pitch move it by decimetres)
         h_mid = float(np.mean(antenna_h))
         table = self._clutter_mean_db_table(np.array([h_mid - 0.05, h_mid + 0.05]))
         slope = ((table[1] - table[0]) / 0.1).astype(np.float32)
-        dh = (antenna_h - h_mid).astype(np.float32)
+        dh = (h_rows - h_mid).astype(np.float32)
         mean_db = (table.mean(axis=0).astype(np.float32))[None, :] + dh[:, None] * slope[None, :]
         # vertical pattern at the sea cell's depression in the antenna frame (roll and pitch included)
         psi = phys.grazing_angle_deg(h_mid, self.r64)
         psi_r = np.radians(np.where(np.isfinite(psi), np.maximum(psi, 1e-3), 1.0)).astype(np.float32)
-        bearing = np.radians(azimuth)
-        dxy = np.stack([np.cos(bearing), -np.sin(bearing), np.zeros(S)], 1)  # horizontal boresight, sensor frame
-        bore = np.einsum("sij,sj->si", rot, dxy)
+        bearing = np.radians(azimuth[rows])
+        dxy = np.stack([np.cos(bearing), -np.sin(bearing), np.zeros(rows.size)], 1)  # horizontal boresight, sensor frame
+        bore = np.einsum("sij,sj->si", rot[rows], dxy)
         bh = bore[:, :2] / np.maximum(np.linalg.norm(bore[:, :2], axis=1, keepdims=True), 1e-12)
-        z_ax = rot[:, :, 2]  # the antenna's up axis in the world
+        z_ax = rot[rows, :, 2]  # the antenna's up axis in the world
         sin_tilt = (z_ax[:, 0] * bh[:, 0] + z_ax[:, 1] * bh[:, 1]).astype(np.float32)
         sin_el = np.cos(psi_r)[None, :] * sin_tilt[:, None] - np.sin(psi_r)[None, :] * z_ax[:, 2].astype(np.float32)[:, None]
         # two-way Gaussian pattern in dB at the elevation asin(sin_el): ~ sin_el (0.5 % at 10 deg) except in the
@@ -354,35 +356,37 @@ class RadarRenderer:
         el_sq = sin_el * sin_el
         el_sq[:, :steep] = np.arcsin(np.clip(sin_el[:, :steep], -1.0, 1.0)) ** 2
         mean_db += np.float32(2.0 * phys.one_way_gain_db(math.degrees(1.0), p.beam_el_deg)) * el_sq
-        mean_db[self.range_m[None, :] >= first_hit[:, None]] = -300.0  # radar shadow behind the first hit
         mean = np.power(np.float32(10.0), mean_db * np.float32(0.1))
-        if self.env.sea_state <= 0:
-            return mean, None
-        # texture: the sea's own field at the cells' world positions, averaged over the beam in azimuth. The
-        # average is smooth over a beamwidth, so it is formed on every sub-th spoke and repeated
-        beam_spokes = p.beam_az_deg / (360.0 / S)
-        sub = max(1, int(beam_spokes // 8))
-        while S % sub:
-            sub -= 1
-        rows = np.arange(0, S, sub)
-        rng32 = self.range_m[None, :]
-        east = pos[rows, 0, None].astype(np.float32) + bh[rows, 0, None].astype(np.float32) * rng32
-        north = pos[rows, 1, None].astype(np.float32) + bh[rows, 1, None].astype(np.float32) * rng32
-        z = self.texture_field.sample(east, north, float(t[S // 2]))
-        width = max(1, int(round(beam_spokes / sub)))
-        z = _box_wrap(_box_wrap(z, width), width)
-        std = np.maximum(uniform_filter1d(z.std(axis=0), 33, mode="nearest"), 1e-6)
-        z /= std[None, :]
-        # Ward's shape (REF 3.8) varies with range (grazing, cell area) and with the look direction to the swell
-        psi_c = np.where(np.isfinite(psi), np.maximum(psi, 1e-3), 1.0)
-        area = phys.clutter_cell_area_m2(self.r64, psi_c, self.beam_eq_rad, self.cell_m)
-        log_nu_r = np.log(phys.ward_shape_nu(psi_c, area, p.polarisation, 45.0))  # cos(90 deg) = 0: no swell term
-        swell = -np.cos(np.radians(2.0 * ((azimuth[rows] + heading[rows]) - self.env.wind_from_deg))) / 3.0 * math.log(10.0)
-        texture = self.gamma(z, (log_nu_r[None, :] + swell[:, None]).astype(np.float32))
-        if sub > 1:
-            texture = np.repeat(texture, sub, axis=0)
-        speckle = stream(self.seed, f"radar.clutter.{rev}").standard_exponential((S, N), dtype=np.float32)
-        return mean * texture * speckle, texture
+        texture = None
+        if self.env.sea_state > 0:
+            # texture: the sea's own field at the cells' world positions, averaged over the beam in azimuth
+            rng32 = self.range_m[None, :]
+            east = pos[rows, 0, None].astype(np.float32) + bh[:, 0, None].astype(np.float32) * rng32
+            north = pos[rows, 1, None].astype(np.float32) + bh[:, 1, None].astype(np.float32) * rng32
+            z = self.texture_field.sample(east, north, float(t[S // 2]))
+            # two passes of a moving average over one beamwidth (circular in azimuth; on the transposed,
+            # contiguous array), then unit variance again at each range
+            width = max(1, int(round(beam_spokes / sub)))
+            zt = np.ascontiguousarray(z.T)
+            zt = uniform_filter1d(uniform_filter1d(zt, width, axis=1, mode="wrap"), width, axis=1, mode="wrap")
+            std = np.maximum(uniform_filter1d(zt.std(axis=1), 33, mode="nearest"), 1e-6)
+            z = np.ascontiguousarray((zt / std[:, None]).T)
+            # Ward's shape (REF 3.8) varies with range (grazing, cell area) and with the look direction to the swell
+            psi_c = np.where(np.isfinite(psi), np.maximum(psi, 1e-3), 1.0)
+            area = phys.clutter_cell_area_m2(self.r64, psi_c, self.beam_eq_rad, self.cell_m)
+            log_nu_r = np.log(phys.ward_shape_nu(psi_c, area, p.polarisation, 45.0))  # cos(90 deg) = 0: no swell term
+            swell = -np.cos(np.radians(2.0 * ((azimuth[rows] + heading[rows]) - self.env.wind_from_deg))) / 3.0 * math.log(10.0)
+            texture = self.gamma(z, (log_nu_r[None, :] + swell[:, None]).astype(np.float32))
+            mean *= texture
+        clutter = np.repeat(mean, sub, axis=0) if sub > 1 else mean
+        if texture is not None:
+            clutter *= stream(self.seed, f"radar.clutter.{rev}").standard_exponential((S, N), dtype=np.float32)
+            texture = np.repeat(texture, sub, axis=0) if sub > 1 else texture
+        # radar shadow: no sea echo at or behind the first object hit of each spoke
+        hit_rows = np.flatnonzero(np.isfinite(first_hit))
+        if hit_rows.size:
+            clutter[hit_rows] *= self.range_m[None, :] < first_hit[hit_rows, None]
+        return clutter, texture
 
     def _ftc(self, p_db: np.ndarray) -> np.ndarray:
         """Rain control (FTC): subtract the log video's excess over the noise, low-passed along range (one-sided).

@@ -388,6 +388,11 @@ def quantise(power_db, floor_db: float, step_db: float, levels: int = 16) -> np.
     """4-bit video on FIXED absolute levels: ``clip(floor((P_dB - floor_dB)/step_dB), 0, 15)``.
 
     Levels are relative to the receiver noise (P in dB re. noise), never to each spoke's maximum.
+    NaN reads 0, +inf the top level.
     """
-    v = np.floor((np.asarray(power_db, dtype=float) - floor_db) / step_db)
-    return np.clip(np.nan_to_num(v, nan=0.0, neginf=0.0, posinf=levels - 1), 0, levels - 1).astype(np.uint8)
+    p = np.asarray(power_db)
+    p = p.astype(np.float32) if p.dtype != np.float32 else p
+    v = (p - np.float32(floor_db)) * np.float32(1.0 / step_db)
+    v = np.nan_to_num(v, nan=0.0, posinf=levels - 0.5, neginf=0.0)
+    np.clip(v, 0.0, levels - 0.5, out=v)
+    return v.astype(np.uint8)  # truncation is floor on [0, levels)
