@@ -145,8 +145,8 @@ RUBBER_PERMITTIVITY = 3.0
 # Smooth metal plates, sea surface: 5 deg (a 0.5 m facet at lambda = 3.19 cm has a
 # lambda/(2a) ~ 1.8 deg lobe; 5 deg allows for dents, rivets and paint) (unverified).
 SMOOTH_HALF_WIDTH_DEG = 5.0
-# Moderately rough dielectrics (ice, GRP): 15-20 deg (unverified).
-ICE_HALF_WIDTH_DEG = 20.0
+# Moderately rough dielectrics: GRP 15 deg, weathered ice 35 deg (unverified).
+ICE_HALF_WIDTH_DEG = 35.0  # weathered berg faces: broad, so berg RCS follows projected area (REF 3.6)
 GRP_HALF_WIDTH_DEG = 15.0
 # Rough surfaces (wood, concrete, rubber): 30 deg; very rough/volume scatterers (snow,
 # asphalt): 45 deg (unverified).
@@ -155,11 +155,17 @@ VERY_ROUGH_HALF_WIDTH_DEG = 45.0
 # Trihedral corner reflector: -3 dB full beam width about 40 deg (unverified).
 CORNER_REFLECTOR_HALF_WIDTH_DEG = 20.0
 
+# Painted steelwork of ships and structures as meshes describe it (flat panels without the fittings,
+# rails, welds and small corners that make real ships bright from every aspect): a Lambertian lobe
+# (cos^n falls to one half at 60 deg for n = 1) (unverified).
+STRUCTURE_HALF_WIDTH_DEG = 60.0
+
 # --- Radar rms roughness heights (engineering defaults, unverified) ---------------------------
 # Rayleigh criterion at lambda = 3.19 cm: h << lambda / (8 cos) ~ 4 mm is smooth. Painted plate,
 # gelcoat: 0.5 mm (mirror-like); weathered berg ice: 1 cm (fully rough at X band); snow 2 cm;
 # timber, concrete, rubber: 3 mm; asphalt 5 mm; the sea is never a target (its echo is clutter): 0.
 SMOOTH_ROUGHNESS_M = 0.0005
+STRUCTURE_ROUGHNESS_M = 0.003  # coherent fraction exp(-(4 pi h / lambda)^2) = 0.25 at normal incidence
 ICE_ROUGHNESS_M = 0.01
 SNOW_ROUGHNESS_M = 0.02
 ROUGH_ROUGHNESS_M = 0.003
@@ -202,8 +208,10 @@ def _conductor(
 #: The order is stable: append new materials at the end, never reorder.
 MATERIALS: tuple[Material, ...] = (
     _conductor(
-        "steel_painted", 0.30, False, SMOOTH_HALF_WIDTH_DEG, SMOOTH_ROUGHNESS_M,
-        "905 nm: 0.30 for grey/white marine paint (unverified); radar: metal, 0 dB.",
+        "steel_painted", 0.30, False, STRUCTURE_HALF_WIDTH_DEG, STRUCTURE_ROUGHNESS_M,
+        "905 nm: 0.30 for grey/white marine paint (unverified); radar: metal, 0 dB; ship and harbour "
+        "steelwork: the rough part (3 mm, Lambertian lobe) stands for the structure a mesh leaves out "
+        "(fittings, rails, welds, small corners) (unverified).",
     ),
     _conductor(
         "aluminium", 0.60, False, SMOOTH_HALF_WIDTH_DEG, SMOOTH_ROUGHNESS_M,

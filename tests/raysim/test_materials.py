@@ -104,7 +104,8 @@ def test_only_the_retroreflector_is_retroreflective():
 def test_specular_exponent_half_power_and_ordering():
     n = specular_exponent_from_half_width_deg(20.0)
     assert math.cos(math.radians(20.0)) ** n == pytest.approx(0.5)
-    assert by_name("steel_painted").specular_exponent > by_name("ice").specular_exponent > 1.0
+    assert by_name("aluminium").specular_exponent > by_name("ice").specular_exponent > 1.0
+    assert by_name("steel_painted").radar_roughness_m > by_name("aluminium").radar_roughness_m
     assert by_name("snow").specular_exponent < by_name("ice").specular_exponent
 
 

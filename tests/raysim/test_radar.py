@@ -237,7 +237,7 @@ def peak_target_db(renderer, bearing_deg=0.0):
     return 10.0 * np.log10(float(window.max())), float(renderer.range_m[j])
 
 
-def plate(tmp_path, name, width_m, height_m, distance_m, centre_z_m, yaw_deg=0.0, material="steel_painted"):
+def plate(tmp_path, name, width_m, height_m, distance_m, centre_z_m, yaw_deg=0.0, material="aluminium"):
     mesh = box_file(tmp_path, name, (width_m, 0.05, height_m), (0.0, 0.0, centre_z_m))
     return {"name": name, "kind": "mesh", "mesh": mesh, "material": material, "position": latlon(0.0, distance_m),
             "heading_deg": 90.0 + yaw_deg}  # body x across the line of sight: the face looks at the radar
@@ -274,7 +274,7 @@ def test_a_metal_sphere_returns_pi_a_squared_whatever_its_tessellation(tmp_path)
         mesh = trimesh.creation.icosphere(subdivisions=subdivisions, radius=1.0)
         mesh.apply_translation((0.0, 0.0, 4.0))
         mesh.export(tmp_path / f"sphere{subdivisions}.stl")
-        sphere = {"name": "sphere", "kind": "mesh", "mesh": f"sphere{subdivisions}.stl", "material": "steel_painted",
+        sphere = {"name": "sphere", "kind": "mesh", "mesh": f"sphere{subdivisions}.stl", "material": "aluminium",
                   "position": latlon(0.0, 150.0), "heading_deg": 0.0}
         r = fine_renderer(tmp_path, [sphere], f"sphere{subdivisions}", multipath=False)
         got_db, at_m = peak_target_db(r)
