@@ -169,6 +169,9 @@ class Radar:
     samples: int = param(1024, doc="Samples per spoke", ge=64, le=4096)
     mount: Mount = param(default_factory=lambda: Mount(z_m=4.0), doc="Mounting on the own ship (body frame)")
     polarisation: Literal["HH", "VV"] = param("HH", doc="Polarisation (marine X-band sets are HH); sets the NRL clutter and K shape")
+    gain_db: float = param(
+        0.0, doc="Receiver gain re. the default setting, dB: every video level moves down by as much (the default "
+        "threshold, 9.6 dB over noise, gives a false-alarm rate of about 1e-4)", ge=-30, le=30)
     sea_clutter_control_db: float = param(
         20.0, doc="Sea control (STC): attenuation at 100 m, rising 40 dB/decade to 0; 0 turns it off", ge=0, le=80)
     rain_clutter_control_m: float = param(

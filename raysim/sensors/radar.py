@@ -99,7 +99,8 @@ class RadarParams:
     @classmethod
     def from_config(cls, cfg) -> "RadarParams":
         """The parameters a scenario's ``sensors.radar`` block sets (the rest at their defaults)."""
-        return cls(polarisation=cfg.polarisation, stc_a0_db=cfg.sea_clutter_control_db,
+        return cls(polarisation=cfg.polarisation, video_floor_db=cls.video_floor_db - cfg.gain_db,
+                   stc_a0_db=cfg.sea_clutter_control_db,
                    ftc_m=cfg.rain_clutter_control_m, blanking_m=cfg.blanking_m, multipath=cfg.multipath,
                    earth_curvature=cfg.earth_curvature, beam_az_deg=cfg.beam_az_deg, beam_el_deg=cfg.beam_el_deg,
                    resolve_m=cfg.resolve_m)

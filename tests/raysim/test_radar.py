@@ -109,6 +109,10 @@ def test_nrl_level_of_the_clutter_for_a_clean_geometry(tmp_path):
     kt0 = 10 ** ((-174.0 - 30.0) / 10)
     snr = (0.1 * (10 ** 2.3) ** 2 * lam**2 * 10 ** (-43.7 / 10) * area * 1e-3) / ((4 * np.pi) ** 3 * r[i] ** 4 * kt0 * 10 ** 0.5 * 10 ** 0.6)
     assert renderer._clutter_mean_db[i] == pytest.approx(10 * np.log10(snr), abs=0.5)
+    # ... and the rendered clutter (texture x speckle, mean 1) averages to it, less the vertical pattern at -1 deg
+    clutter = renderer.revolution(0).clutter[:, i - 8 : i + 9]
+    expected = np.mean(10 ** (renderer._clutter_mean_db[i - 8 : i + 9] / 10)) * np.exp(-8 * np.log(2) * (1 / 25) ** 2)
+    assert 10 * np.log10(clutter.mean()) == pytest.approx(10 * np.log10(expected), abs=1.5)
 
 
 def test_rain_attenuates_far_echoes_by_the_itu_two_way_loss(tmp_path):
@@ -215,6 +219,20 @@ def test_a_low_wide_target_beyond_the_horizon_is_visible_only_on_a_flat_earth(tm
         peaks[curved] = int(r.render_revolution(0)["echo"][around(0.0, 3)][:, bins].max())
     assert peaks[False] >= 4
     assert peaks[True] <= 1
+
+
+def test_a_15_m_berg_at_the_range_scale_is_hit_by_several_rays_each_way(tmp_path):
+    berg = {"name": "berg", "kind": "iceberg", "position": latlon(1800.0 * np.sin(0.3), 1800.0 * np.cos(0.3)),
+            "radius_m": 7.5, "height_m": 6, "seed": 2}
+    r, _ = radar_world(tmp_path, obstacles=[berg], environment={"sea_state": 0, "wind_speed_mps": 0}, name="far")
+    t, _, _, _, _, o_w, d_w, o_b, d_b = r.rays(0)
+    hits, on_carrier = r.scene.cast(o_w, d_w, np.repeat(t, r.k), o_b, d_b, max_range_m=3000.0)
+    on_berg = np.flatnonzero(hits.object_id == r.world.objects[-1].object_id)
+    azimuth_rays = np.unique(on_berg // r.el_rad.size)  # spoke x sub-ray
+    elevation_rays = np.unique(on_berg % r.el_rad.size)
+    assert azimuth_rays.size >= 2 and elevation_rays.size >= 2  # resolve_m 6 m: 15 m spans 2.5 ray spacings
+    echo = r.render_revolution(0)["echo"]
+    assert echo[around(np.degrees(0.3), 4)][:, int(1770 / r.dr): int(1830 / r.dr)].max() >= 3
 
 
 # ---------------------------------------------------------------- calibration against analytic RCS (REF 3.6)
@@ -395,13 +413,16 @@ def test_main_bang_blanking_zeroes_the_first_samples(tmp_path):
 def test_scenario_keys_set_the_radar_model(tmp_path):
     data = scenario(tmp_path, duration=3.0)
     data["sensors"] = {"lidar": {"enabled": False},
-                       "radar": {"spokes": 256, "samples": 256, "polarisation": "VV", "multipath": False,
+                       "radar": {"spokes": 256, "samples": 256, "polarisation": "VV", "multipath": False, "gain_db": 4.0,
                                  "earth_curvature": False, "sea_clutter_control_db": 0, "rain_clutter_control_m": 15,
                                  "blanking_m": 10, "beam_az_deg": 4.0, "beam_el_deg": 20.0, "resolve_m": 8.0}}
     path = tmp_path / "keys.yaml"
     path.write_text(yaml.safe_dump(data))
     world = World(load_scenario(path))
     r = RadarRenderer(world, CarrierScene(world.scene_objects(), sea_material=material_index("sea")))
+    assert r.p.video_floor_db == pytest.approx(6.6 - 4.0)
+    noise_only = r.render_revolution(0)["echo"][:, 200:]
+    assert 0.01 < (noise_only > 0).mean() < 0.05  # 5.6 dB over noise: Pfa = exp(-10^0.56) = 2.6 %
     assert (r.p.polarisation, r.p.multipath, r.p.earth_curvature, r.p.stc_a0_db, r.p.ftc_m, r.p.blanking_m,
             r.p.beam_az_deg, r.p.beam_el_deg, r.p.resolve_m) == ("VV", False, False, 0.0, 15.0, 10.0, 4.0, 20.0, 8.0)
     data["sensors"]["radar"]["sea_clutter_contol_db"] = 3
