@@ -64,7 +64,14 @@ def _render_radar(ctx: "RenderContext") -> None:
 
 
 #: Sensor name -> renderer(context). Sensors register here as they are implemented.
-SENSOR_RENDERERS: dict[str, Callable[[RenderContext], None]] = {"lidar": _render_lidar, "radar": _render_radar}
+def _render_ais(ctx: "RenderContext") -> None:
+    from raysim.sensors.ais import render_ais
+
+    render_ais(ctx)
+
+
+SENSOR_RENDERERS: dict[str, Callable[[RenderContext], None]] = {"lidar": _render_lidar, "radar": _render_radar,
+                                                                "ais": _render_ais}
 
 
 @dataclass(frozen=True)

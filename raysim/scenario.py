@@ -210,13 +210,24 @@ class AisNoise:
 class Ais:
     enabled: bool = param(True, doc="Receive AIS")
     range_m: float = param(10_000.0, doc="Reception range, m", gt=0, le=200_000)
+    antenna_height_m: float = param(5.0, doc="Height of the own ship's VHF antenna above the sea, m (radio horizon)", gt=0, le=100)
+    radio_horizon: bool = param(True, doc="Limit reception to the VHF radio horizon 4.12 (sqrt(h_tx) + sqrt(h_rx)) km")
     noise: AisNoise = param(default_factory=AisNoise, doc="Transponder error model (thesis section 2.5)")
 
 
 @dataclass(frozen=True, kw_only=True)
 class Nav:
     enabled: bool = param(True, doc="Write the own-ship navigation solution")
-    rate_hz: float = param(50.0, doc="Navigation output rate, Hz", gt=0, le=200)
+    rate_hz: float = param(50.0, doc="Navigation output rate (ownship.jsonl), Hz", gt=0, le=200)
+    nmea_rate_hz: float = param(1.0, doc="Rate of the GNSS/compass NMEA lines (nav/nav.nmea), Hz", gt=0, le=50)
+    position_noise_m: float = param(0.1, doc="GNSS position white noise, standard deviation per axis, m", ge=0, le=100)
+    position_bias_m: float = param(0.5, doc="GNSS position Gauss-Markov bias, standard deviation per axis, m", ge=0, le=100)
+    position_bias_time_constant_s: float = param(300.0, doc="Time constant of the position bias, s", gt=0)
+    velocity_noise_mps: float = param(0.02, doc="GNSS velocity white noise, standard deviation per axis, m/s", ge=0, le=10)
+    heading_noise_deg: float = param(0.05, doc="Heading (INS/compass) white noise, standard deviation, deg", ge=0, le=10)
+    heading_bias_deg: float = param(0.1, doc="Heading Gauss-Markov bias, standard deviation, deg", ge=0, le=10)
+    heading_bias_time_constant_s: float = param(600.0, doc="Time constant of the heading bias, s", gt=0)
+    attitude_noise_deg: float = param(0.02, doc="Roll and pitch white noise, standard deviation, deg", ge=0, le=10)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -249,11 +260,42 @@ class Obstacle:
     material: str | None = param(None, doc="Material of a mesh file's faces", default_doc="concrete (mesh)")
 
 
+def _periods_check(value) -> str | None:
+    for i, (start, end) in enumerate(value):
+        if not start < end:
+            return f"period {i}: start {start} must be before end {end}"
+    return None
+
+
+def _ais_text_check(value: str) -> str | None:
+    allowed = set("@ABCDEFGHIJKLMNOPQRSTUVWXYZ[\\]^_ !\"#$%&'()*+,-./0123456789:;<=>?")
+    bad = sorted({c for c in value.upper() if c not in allowed})
+    if bad:
+        return f"characters {''.join(bad)!r} are not in the AIS 6-bit character set"
+    return None
+
+
 @dataclass(frozen=True, kw_only=True)
 class ShipAis:
     enabled: bool = param(True, doc="Transponder on (false = a silent ship)")
     mmsi: int = param(doc="Maritime Mobile Service Identity, 9 digits", check=_mmsi_check)
-    ais_class: Literal["A", "B"] = param("A", doc="Transponder class")
+    ais_class: Literal["A", "B"] = param("A", doc="Transponder class: A (types 1/3 and 5) or B (types 18 and 24)")
+    name: str | None = param(None, doc="Vessel name, up to 20 characters", default_doc="the ship's name, upper case",
+                             check=_ais_text_check)
+    call_sign: str | None = param(None, doc="Call sign, up to 7 characters; null: not available", check=_ais_text_check)
+    ship_type: int | None = param(None, doc="ITU ship and cargo type, 0..99", ge=0, le=99,
+                                  default_doc="70 (cargo) for class A, 37 (pleasure craft) for class B")
+    draught_m: float | None = param(None, doc="Draught, m", ge=0, le=25.5, default_doc="0.06 x length_m, at most 25.5")
+    destination: str | None = param(None, doc="Destination, up to 20 characters; null: not available", check=_ais_text_check)
+    nav_status: Literal["auto", "under_way", "at_anchor", "moored"] = param(
+        "auto", doc="Navigation status; auto: at anchor when anchored, else under way using engine")
+    antenna_height_m: float | None = param(None, doc="Transmitting antenna height above the sea, m", gt=0, le=100,
+                                           default_doc="the ship's height")
+    dropout_probability: float = param(0.0, doc="Chance that a report is lost (intermittent reception)", ge=0, le=1)
+    off_periods_s: tuple[tuple[float, float], ...] = param(
+        (), doc="Periods [start, end] (s) with the transponder switched off", check=_periods_check)
+    position_offset_m: tuple[float, float] = param(
+        (0.0, 0.0), doc="Offset [east, north] added to every reported position, m (a spoofed or misconfigured fix)")
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -1,0 +1,228 @@
+"""AIS traffic as the own ship's receiver hears it: ``ais/ais.nmea``.
+
+For every ship with an enabled transponder (REFERENCE.md section 4):
+
+1. Kinematics on a 0.5 s grid from its motion: SOG, COG, true heading and the rate of turn
+   (deg/min, from the heading's time derivative).
+2. Schedule (:mod:`raysim.sensors.ais_schedule`): Class A position reports (type 1; type 3 for
+   the first report after the reporting rate changes, as ITDMA announces new slots) at the
+   ITU-R M.1371 intervals for its speed, turning and navigation status, type 5 at start and every
+   6 min; Class B type 18 every 30 s / 3 min and type 24 parts A and B every 6 min. Channels
+   alternate A/B per transmission.
+3. Errors (:mod:`raysim.sensors.gauss_markov`): every transmitted quantity gets the thesis's white
+   noise plus first-order Gauss-Markov bias (``sensors.ais.noise``, named as in the thesis); the
+   position error is drawn per axis (east and north) with the configured variance, SOG in knots,
+   COG and heading in degrees, ROT in deg/min. A configured ``position_offset_m`` is added to
+   every reported position (spoofing, a misplaced antenna). Fields are clamped before encoding
+   (:mod:`raysim.sensors.ais_fields`).
+4. Failures and reception: nothing while the transponder is off (``off_periods_s``, or disabled:
+   a silent ship), each transmission lost with ``dropout_probability``, and only what is within
+   ``sensors.ais.range_m`` and the VHF radio horizon ``4.12 (sqrt(h_tx) + sqrt(h_rx))`` km
+   (4/3 earth) of the own ship at the time is received.
+5. Output: every received message as ``!AIVDM`` sentences (pyais), each line prefixed by an NMEA
+   4.10 TAG block with its reception time ``\\c:<unix s>*hh\\``; multi-sentence messages (type 5)
+   carry a sequential message id 0..9. Lines are in time order; the file is deterministic.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from pyais import encode_dict
+
+from raysim.pose import heading_deg_from_yaw
+from raysim.random_streams import stream
+from raysim.recording.jsonl import course_and_speed
+from raysim.recording.nmea import tag_block
+from raysim.recording.staging import atomic_path
+from raysim.sensors import ais_fields as fields
+from raysim.sensors import ais_schedule as schedule
+from raysim.sensors.gauss_markov import white_plus_bias
+
+__all__ = ["AisMessage", "ship_messages", "received_messages", "ais_lines", "render_ais", "radio_horizon_m"]
+
+KNOTS_PER_MPS = 3600.0 / 1852.0
+GRID_S = 0.5  # kinematics grid (finer than the 2 s shortest interval)
+
+
+def radio_horizon_m(tx_height_m: float, rx_height_m: float) -> float:
+    """VHF radio horizon over a 4/3 earth: ``4.12 (sqrt(h_tx) + sqrt(h_rx))`` km."""
+    return 4120.0 * (math.sqrt(max(tx_height_m, 0.0)) + math.sqrt(max(rx_height_m, 0.0)))
+
+
+@dataclass(frozen=True)
+class AisMessage:
+    """One transmission: its time, sender, channel and pyais fields (``seq_id`` set when written)."""
+
+    t_s: float
+    mmsi: int
+    channel: str
+    data: dict
+
+
+def _kinematics(obj, t: np.ndarray) -> dict:
+    poses = obj.motion.poses(t)
+    cog, sog_mps = course_and_speed(obj.motion.velocity_mps(t), poses.yaw_rad)
+    heading = heading_deg_from_yaw(poses.yaw_rad)
+    rot = np.gradient(np.degrees(np.unwrap(np.radians(heading))), t) * 60.0 if t.size > 1 else np.zeros(t.size)
+    return {"x": poses.position_m[:, 0], "y": poses.position_m[:, 1], "cog_deg": cog, "sog_kn": sog_mps * KNOTS_PER_MPS,
+            "heading_deg": heading, "rot_deg_per_min": rot}
+
+
+def _interp(grid: np.ndarray, values: np.ndarray, t: np.ndarray) -> np.ndarray:
+    return np.interp(t, grid, values)
+
+
+def ship_messages(world, obj, ship_cfg) -> list[AisMessage]:
+    """Every message the transponder of ``obj`` transmits during the run (before reception).
+
+    Parameters
+    ----------
+    world : raysim.world.World
+    obj : raysim.world.WorldObject
+        A ship with ``obj.ais`` set and enabled.
+    ship_cfg : raysim.scenario.Ship
+        Its scenario entry (speed, for the anchored status).
+    """
+    s = world.scenario
+    cfg = obj.ais
+    noise = s.sensors.ais.noise
+    mmsi = cfg.mmsi
+    duration = s.duration_s
+    grid = np.arange(0.0, duration + GRID_S, GRID_S)
+    kin = _kinematics(obj, grid)
+    status_name = cfg.nav_status
+    if status_name == "auto":
+        status_name = "at_anchor" if ship_cfg.speed_kn == 0 else "under_way"
+    status = fields.NAV_STATUS[status_name]
+    anchored = np.full(grid.size, status_name in ("at_anchor", "moored"))
+    turning = np.abs(kin["rot_deg_per_min"]) > schedule.TURNING_DEG_PER_MIN
+    rng = stream(s.seed, f"ais.{mmsi}.schedule")
+    if cfg.ais_class == "A":
+        interval = schedule.class_a_interval_s(kin["sog_kn"], turning, anchored)
+    else:
+        interval = schedule.class_b_interval_s(kin["sog_kn"])
+    t = schedule.due_times(grid, interval, rng, duration)
+
+    # errors of the thesis's model at the report times, one named stream per quantity
+    def err(name, var_w, var_b, tau):
+        return white_plus_bias(stream(s.seed, f"ais.{mmsi}.{name}"), t, math.sqrt(var_w), math.sqrt(var_b), tau)
+
+    east = _interp(grid, kin["x"], t) + cfg.position_offset_m[0] + err(
+        "position_east", noise.position_measure_variance_m2, noise.position_bias_variance_m2,
+        noise.position_bias_time_constant_sec)
+    north = _interp(grid, kin["y"], t) + cfg.position_offset_m[1] + err(
+        "position_north", noise.position_measure_variance_m2, noise.position_bias_variance_m2,
+        noise.position_bias_time_constant_sec)
+    lat, lon = world.frame.to_geodetic(east, north)
+    sog = _interp(grid, kin["sog_kn"], t) + err("sog", noise.sog_measure_variance_knots2, noise.sog_bias_variance_knots2,
+                                                 noise.sog_bias_time_constant_sec)
+    cog_true = np.degrees(np.unwrap(np.radians(kin["cog_deg"])))
+    cog = _interp(grid, cog_true, t) + err("cog", noise.cog_measure_variance_deg2, noise.cog_bias_variance_deg2,
+                                           noise.cog_bias_time_constant_sec)
+    hdg_true = np.degrees(np.unwrap(np.radians(kin["heading_deg"])))
+    heading = _interp(grid, hdg_true, t) + err("heading", noise.track_measure_variance_deg2,
+                                               noise.track_bias_variance_deg2, noise.track_bias_time_constant_sec)
+    rot = _interp(grid, kin["rot_deg_per_min"], t) + err("rot", noise.rot_measure_variance_deg2_pr_min2,
+                                                         noise.rot_bias_variance_deg2_pr_min2,
+                                                         noise.rot_bias_time_constant_sec)
+    accuracy = math.sqrt(noise.position_measure_variance_m2 + noise.position_bias_variance_m2) <= 10.0
+    start = s.start_time
+    seconds = np.floor((start.second + start.microsecond * 1e-6 + t) % 60.0)
+    iv = _interp(grid, interval, t)
+    rate_changed = np.concatenate([[False], np.abs(np.diff(iv)) > 1e-6])
+
+    messages = []
+    for k in range(t.size):  # one pyais field dict per transmission (pyais encodes message by message)
+        if cfg.ais_class == "A":
+            data = fields.position_report(3 if rate_changed[k] else 1, mmsi, status, float(rot[k]), float(sog[k]),
+                                          accuracy, float(lon[k]), float(lat[k]), float(cog[k]), float(heading[k]),
+                                          float(seconds[k]))
+        else:
+            data = fields.class_b_report(mmsi, float(sog[k]), accuracy, float(lon[k]), float(lat[k]), float(cog[k]),
+                                         float(heading[k]), float(seconds[k]))
+        messages.append((float(t[k]), data))
+
+    # static data: at start (within the first 6 s) and every 6 min
+    name = cfg.name or obj.name
+    length, beam = obj.length_m, obj.beam_m
+    t0 = float(np.round(rng.uniform(0.0, 6.0) / schedule.SLOT_S) * schedule.SLOT_S)
+    static_t = np.arange(t0, duration, schedule.STATIC_INTERVAL_S)
+    if cfg.ais_class == "A":
+        ship_type = 70 if cfg.ship_type is None else cfg.ship_type
+        draught = min(0.06 * length, 25.5) if cfg.draught_m is None else cfg.draught_m
+        static = fields.static_report(mmsi, name, cfg.call_sign, ship_type, length, beam, draught, cfg.destination)
+        messages += [(float(ts), static) for ts in static_t]
+    else:
+        ship_type = 37 if cfg.ship_type is None else cfg.ship_type
+        part_a = fields.static_report_b(mmsi, 0, name, cfg.call_sign, ship_type, length, beam)
+        part_b = fields.static_report_b(mmsi, 1, name, cfg.call_sign, ship_type, length, beam)
+        messages += [(float(ts), part_a) for ts in static_t]
+        messages += [(float(ts + schedule.SLOT_S), part_b) for ts in static_t]
+    messages.sort(key=lambda m: (m[0], m[1]["msg_type"]))
+    first = "A" if rng.uniform() < 0.5 else "B"
+    other = {"A": "B", "B": "A"}
+    return [AisMessage(tm, mmsi, first if i % 2 == 0 else other[first], data) for i, (tm, data) in enumerate(messages)]
+
+
+def received_messages(world, messages: list[AisMessage], obj) -> list[AisMessage]:
+    """The transmissions of ``obj`` the own ship receives: transponder on, not dropped, in range."""
+    s = world.scenario
+    cfg = obj.ais
+    if not messages:
+        return []
+    t = np.array([m.t_s for m in messages])
+    keep = np.ones(t.size, dtype=bool)
+    for start, end in cfg.off_periods_s:
+        keep &= ~((t >= start) & (t < end))
+    if cfg.dropout_probability > 0:
+        keep &= stream(s.seed, f"ais.{cfg.mmsi}.dropout").uniform(size=t.size) >= cfg.dropout_probability
+    rx = s.sensors.ais
+    own = world.own_ship.motion.poses(t).position_m
+    ship = obj.motion.poses(t).position_m
+    distance = np.hypot(ship[:, 0] - own[:, 0], ship[:, 1] - own[:, 1])
+    limit = rx.range_m
+    if rx.radio_horizon:
+        tx_h = cfg.antenna_height_m if cfg.antenna_height_m is not None else obj.height_m
+        limit = min(limit, radio_horizon_m(tx_h, rx.antenna_height_m))
+    keep &= distance <= limit
+    return [m for m, k in zip(messages, keep) if k]
+
+
+def ais_lines(messages: list[AisMessage], start_time: dt.datetime) -> list[str]:
+    """NMEA lines of the messages in time order: TAG block + ``!AIVDM`` sentence; seq ids 0..9 for multi-part."""
+    order = sorted(messages, key=lambda m: (m.t_s, m.mmsi, m.data["msg_type"]))
+    base = start_time.timestamp()
+    lines, seq = [], 0
+    for m in order:
+        sentences = encode_dict(m.data, talker_id="AI", sentence_type="VDM", radio_channel=m.channel, seq_id=seq)
+        if len(sentences) > 1:
+            seq = (seq + 1) % 10
+        tag = tag_block(base + m.t_s)
+        lines += [tag + s for s in sentences]
+    return lines
+
+
+def render_ais(ctx) -> None:
+    """The ``ais`` entry for :data:`raysim.render.SENSOR_RENDERERS`: writes ``ais/ais.nmea``."""
+    world = ctx.world
+    ships = {ship.name: ship for ship in world.scenario.ships}
+    received, transmitted = [], 0
+    for obj in world.objects:
+        if obj.kind != "ship" or obj.ais is None or not obj.ais.enabled:
+            continue  # no transponder, or a silent ship: never transmits
+        sent = ship_messages(world, obj, ships[obj.name])
+        transmitted += len(sent)
+        received += received_messages(world, sent, obj)
+    lines = ais_lines(received, world.scenario.start_time)
+    path = Path(ctx.out_dir) / "ais" / "ais.nmea"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_path(path) as tmp:
+        tmp.write_text("".join(line + "\n" for line in lines), encoding="ascii", newline="\n")
+    ctx.counts["ais/ais.nmea"] = len(lines)
+    ctx.counts["ais/messages_transmitted"] = transmitted
+    ctx.counts["ais/messages_received"] = len(received)
