@@ -187,23 +187,41 @@ class Radar:
 
 @dataclass(frozen=True, kw_only=True)
 class AisNoise:
-    """The thesis's AIS noise parameters (appendix B.3), named as there without the ``AIS_`` prefix."""
+    """The thesis's AIS noise parameters (appendix B.3), named as there without the ``AIS_`` prefix.
 
-    position_measure_variance_m2: float = param(5.0, doc="White-noise variance of position, m^2", ge=0)
-    cog_measure_variance_deg2: float = param(1.0, doc="White-noise variance of COG, deg^2", ge=0)
-    track_measure_variance_deg2: float = param(1.0, doc="White-noise variance of true heading, deg^2", ge=0)
-    rot_measure_variance_deg2_pr_min2: float = param(2000.0, doc="White-noise variance of ROT, (deg/min)^2", ge=0)
-    sog_measure_variance_knots2: float = param(0.5, doc="White-noise variance of SOG, kn^2", ge=0)
-    position_bias_variance_m2: float = param(0.5, doc="Gauss-Markov bias variance of position, m^2", ge=0)
-    cog_bias_variance_deg2: float = param(0.5, doc="Gauss-Markov bias variance of COG, deg^2", ge=0)
-    track_bias_variance_deg2: float = param(0.5, doc="Gauss-Markov bias variance of heading, deg^2", ge=0)
-    rot_bias_variance_deg2_pr_min2: float = param(500.0, doc="Gauss-Markov bias variance of ROT, (deg/min)^2", ge=0)
-    sog_bias_variance_knots2: float = param(0.1, doc="Gauss-Markov bias variance of SOG, kn^2", ge=0)
-    position_bias_time_constant_sec: float = param(20.0, doc="Bias time constant of position, s", gt=0)
-    cog_bias_time_constant_sec: float = param(10.0, doc="Bias time constant of COG, s", gt=0)
-    track_bias_time_constant_sec: float = param(10.0, doc="Bias time constant of heading, s", gt=0)
-    rot_bias_time_constant_sec: float = param(10.0, doc="Bias time constant of ROT, s", gt=0)
-    sog_bias_time_constant_sec: float = param(10.0, doc="Bias time constant of SOG, s", gt=0)
+    The thesis's own names (``AIS_COG_measure_variance_deg2``, ...) are accepted too.
+    """
+
+    position_measure_variance_m2: float = param(5.0, aliases=("AIS_position_measure_variance_m2",),
+        doc="White-noise variance of position, m^2", ge=0)
+    cog_measure_variance_deg2: float = param(1.0, aliases=("AIS_COG_measure_variance_deg2",),
+        doc="White-noise variance of COG, deg^2", ge=0)
+    track_measure_variance_deg2: float = param(1.0, aliases=("AIS_track_measure_variance_deg2",),
+        doc="White-noise variance of true heading, deg^2", ge=0)
+    rot_measure_variance_deg2_pr_min2: float = param(2000.0, aliases=("AIS_ROT_measure_variance_deg2_pr_min2",),
+        doc="White-noise variance of ROT, (deg/min)^2", ge=0)
+    sog_measure_variance_knots2: float = param(0.5, aliases=("AIS_SOG_measure_variance_knots2",),
+        doc="White-noise variance of SOG, kn^2", ge=0)
+    position_bias_variance_m2: float = param(0.5, aliases=("AIS_position_bias_variance_m2",),
+        doc="Gauss-Markov bias variance of position, m^2", ge=0)
+    cog_bias_variance_deg2: float = param(0.5, aliases=("AIS_COG_bias_variance_deg2",),
+        doc="Gauss-Markov bias variance of COG, deg^2", ge=0)
+    track_bias_variance_deg2: float = param(0.5, aliases=("AIS_track_bias_variance_deg2",),
+        doc="Gauss-Markov bias variance of heading, deg^2", ge=0)
+    rot_bias_variance_deg2_pr_min2: float = param(500.0, aliases=("AIS_ROT_bias_variance_deg2_pr_min2",),
+        doc="Gauss-Markov bias variance of ROT, (deg/min)^2", ge=0)
+    sog_bias_variance_knots2: float = param(0.1, aliases=("AIS_SOG_bias_variance_knots2",),
+        doc="Gauss-Markov bias variance of SOG, kn^2", ge=0)
+    position_bias_time_constant_sec: float = param(20.0, aliases=("AIS_position_bias_time_constant_sec",),
+        doc="Bias time constant of position, s", gt=0)
+    cog_bias_time_constant_sec: float = param(10.0, aliases=("AIS_COG_bias_time_constant_sec",),
+        doc="Bias time constant of COG, s", gt=0)
+    track_bias_time_constant_sec: float = param(10.0, aliases=("AIS_track_bias_time_constant_sec",),
+        doc="Bias time constant of heading, s", gt=0)
+    rot_bias_time_constant_sec: float = param(10.0, aliases=("AIS_ROT_bias_time_constant_sec",),
+        doc="Bias time constant of ROT, s", gt=0)
+    sog_bias_time_constant_sec: float = param(10.0, aliases=("AIS_SOG_bias_time_constant_sec",),
+        doc="Bias time constant of SOG, s", gt=0)
 
 
 @dataclass(frozen=True, kw_only=True)

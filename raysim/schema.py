@@ -38,6 +38,7 @@ def param(
     check: Callable[[Any], str | None] | None = None,
     default_doc: str | None = None,
     default_factory: Callable[[], Any] | None = None,
+    aliases: tuple[str, ...] = (),
 ) -> Any:
     """A schema field.
 
@@ -56,8 +57,11 @@ def param(
         ``check(value) -> message or None`` for anything else.
     default_doc : str, optional
         How the default is derived, when it is not a constant.
+    aliases : tuple of str, optional
+        Other names the key may be given by (e.g. the thesis's own parameter names).
     """
-    meta = dict(doc=doc, ge=ge, gt=gt, le=le, lt=lt, min_items=min_items, check=check, default_doc=default_doc)
+    meta = dict(doc=doc, ge=ge, gt=gt, le=le, lt=lt, min_items=min_items, check=check, default_doc=default_doc,
+                aliases=tuple(aliases))
     if default_factory is not None:
         return dataclasses.field(default_factory=default_factory, metadata=meta)
     return dataclasses.field(default=default, metadata=meta)
@@ -200,6 +204,15 @@ def build(cls: type, data: Any, ctx: Context, path: str = "") -> Any:
         ctx.fail(path, f"must be a mapping of keys to values, got {_type_name(data)}")
     hints = typing.get_type_hints(cls)
     fields = {f.name: f for f in dataclasses.fields(cls) if f.init}
+    alias_of = {a: f.name for f in fields.values() for a in f.metadata.get("aliases", ())}
+    if alias_of and any(key in alias_of for key in data):
+        renamed = {}
+        for key, value in data.items():
+            name = alias_of.get(key, key)
+            if name in renamed:
+                ctx.fail(_child(path, str(key)), f"given twice (as {name} and as {key})")
+            renamed[name] = value
+        data = renamed
     for key in data:
         if key not in fields:
             allowed = ", ".join(fields)
@@ -253,7 +266,10 @@ def describe(cls: type, path: str = "") -> list[tuple[str, str, str, str]]:
             default = "(see below)" if dataclasses.is_dataclass(value) else repr(to_plain(value))
         else:
             default = "required"
-        rows.append((sub, _describe_type(tp), default, f.metadata.get("doc", "")))
+        doc = f.metadata.get("doc", "")
+        if f.metadata.get("aliases"):
+            doc += " (also as " + ", ".join(f"`{a}`" for a in f.metadata["aliases"]) + ")"
+        rows.append((sub, _describe_type(tp), default, doc))
         for candidate in inner:
             if dataclasses.is_dataclass(candidate):
                 rows.extend(describe(candidate, sub))

@@ -16,7 +16,7 @@ from raysim.scenario import load_scenario
 from raysim.sensors import ais_fields as fields
 from raysim.sensors.ais import ais_lines, radio_horizon_m, received_messages, ship_messages
 from raysim.world import World
-from tests.conftest import BASE
+from tests.conftest import BASE, REPO as BASE_DIR
 
 ORIGIN = (BASE["origin"]["lat"], BASE["origin"]["lon"])
 FRAME = LocalFrame(*ORIGIN)
@@ -293,3 +293,18 @@ def test_multi_sentence_messages_get_cycling_sequence_ids():
     assert all(p[3] == "" for p in parts if p[1] == "1")
     assert seq == [str(k % 10) for k in range(12)]
     assert all(line.startswith("\\c:14963184") for line in lines)
+
+
+def test_the_thesis_noise_parameters_are_accepted_as_named_there(write_scenario):
+    import yaml
+
+    thesis = yaml.safe_load((BASE_DIR / "tests" / "data" / "hilsim_busy_open_sea" / "sensor_params.yaml").read_text())
+    noise = {k: v for k, v in thesis.items() if k.startswith("AIS_") and k != "AIS_range_m"}
+    assert len(noise) == 15
+    world = world_of(write_scenario, scenario_dict([ship("s", 257000041, 10.0)], 60.0, noise=noise))
+    n = world.scenario.sensors.ais.noise
+    assert (n.cog_measure_variance_deg2, n.rot_measure_variance_deg2_pr_min2, n.position_bias_time_constant_sec) == (1, 2000, 20)
+    data = scenario_dict([ship("s", 257000041, 10.0)], 60.0,
+                         noise={"AIS_SOG_measure_variance_knots2": 0.5, "sog_measure_variance_knots2": 0.4})
+    path = write_scenario(data, "twice.yaml")
+    assert main(["render", str(path), "-o", str(path.parent / "out")]) == 2
