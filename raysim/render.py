@@ -7,6 +7,7 @@ succeeded. Sensors plug in through :data:`SENSOR_RENDERERS`.
 
 from __future__ import annotations
 
+import datetime as dt
 import json
 import platform
 import sys
@@ -70,8 +71,13 @@ def _render_ais(ctx: "RenderContext") -> None:
     render_ais(ctx)
 
 
+def _render_nav(ctx: "RenderContext") -> None:
+    """nav/nav.nmea (:func:`write_nav_nmea`); ownship.jsonl is written whether or not nav is enabled."""
+    ctx.counts["nav/nav.nmea"] = write_nav_nmea(ctx.world, ctx.out_dir / "nav" / "nav.nmea", ctx.progress)
+
+
 SENSOR_RENDERERS: dict[str, Callable[[RenderContext], None]] = {"lidar": _render_lidar, "radar": _render_radar,
-                                                                "ais": _render_ais}
+                                                                "ais": _render_ais, "nav": _render_nav}
 
 
 @dataclass(frozen=True)
@@ -114,22 +120,52 @@ def write_truth(world: World, path: Path, progress: bool) -> int:
 
 
 def write_ownship(world: World, path: Path, progress: bool) -> int:
-    """Write ownship.jsonl at the navigation rate. Returns the number of lines."""
+    """Write ownship.jsonl at the navigation rate. Returns the number of lines.
+
+    The lines are the navigation solution: the true motion plus the GNSS/INS errors of
+    ``sensors.nav`` (:mod:`raysim.sensors.nav`).
+    """
+    from raysim.sensors.nav import grid_size, navigation_chunks
+
     rate = world.scenario.sensors.nav.rate_hz
-    t_all = _ticks(world.scenario.duration_s, rate)
-    motion = world.own_ship.motion
+    step = max(1, int(CHUNK_S * rate))
+    chunks = -(-grid_size(world.scenario.duration_s, rate) // step)
     lines = 0
     with atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8", newline="\n") as handle:
-        for t in tqdm(list(_chunks(t_all, rate)), desc="ownship", unit="chunk", disable=not progress, leave=False):
-            poses = motion.poses(t)
-            lat, lon = world.frame.to_geodetic(poses.position_m[:, 0], poses.position_m[:, 1])
-            cog, sog = course_and_speed(motion.velocity_mps(t), poses.yaw_rad)
-            columns = dict(
-                lat=lat, lon=lon, x=poses.position_m[:, 0], y=poses.position_m[:, 1], z=poses.position_m[:, 2],
-                heading_deg=heading_deg_from_yaw(poses.yaw_rad), roll_deg=np.degrees(poses.roll_rad),
-                pitch_deg=-np.degrees(poses.pitch_rad), cog_deg=cog, sog_mps=sog,
-            )
+        for t, columns in tqdm(navigation_chunks(world, step), total=chunks, desc="ownship", unit="chunk",
+                               disable=not progress, leave=False):
             lines += write_ownship_chunk(handle, t, columns)
+    return lines
+
+
+def write_nav_nmea(world: World, path: Path, progress: bool) -> int:
+    """Write nav/nav.nmea: TAG block + $GPRMC, $GPGGA, $HEHDT per NMEA epoch. Returns the number of lines.
+
+    The values are the navigation solution of ownship.jsonl at the grid samples of
+    :func:`raysim.sensors.nav.nmea_indices` (every 50th sample with the default 50 Hz / 1 Hz).
+    """
+    from raysim.recording import nmea
+    from raysim.sensors.nav import grid_size, navigation_chunks, nmea_indices
+
+    s = world.scenario
+    cfg = s.sensors.nav
+    indices = nmea_indices(s.duration_s, cfg.rate_hz, cfg.nmea_rate_hz)
+    step = max(1, int(CHUNK_S * cfg.rate_hz))
+    chunks = -(-grid_size(s.duration_s, cfg.rate_hz) // step)
+    lines = 0
+    with atomic_path(path) as tmp, open(tmp, "w", encoding="ascii", newline="\n") as handle:
+        for t, c in tqdm(navigation_chunks(world, step, indices), total=chunks, desc="nav", unit="chunk",
+                         disable=not progress, leave=False):
+            out = []
+            for k, t_s in enumerate(t.tolist()):
+                utc = s.start_time + dt.timedelta(seconds=t_s)
+                tag = nmea.tag_block(utc.timestamp())
+                lat, lon = float(c["lat"][k]), float(c["lon"][k])
+                out += [tag + nmea.gprmc(utc, lat, lon, float(c["sog_mps"][k]), float(c["cog_deg"][k])),
+                        tag + nmea.gpgga(utc, lat, lon, float(c["z"][k])),
+                        tag + nmea.hehdt(float(c["heading_deg"][k]))]
+            handle.write("".join(line + "\n" for line in out))
+            lines += len(out)
     return lines
 
 
