@@ -107,8 +107,11 @@ FLEET = [
 
 
 def test_render_writes_decodable_nmea_from_the_right_ships(write_scenario, tmp_path):
-    path = write_scenario(scenario_dict(FLEET, duration_s=400.0))
-    assert main(["render", str(path), "-o", str(tmp_path / "rec"), "--sensors", "ais"]) == 0
+    data = scenario_dict(FLEET, duration_s=400.0)
+    data["sensors"]["nav"] = {"enabled": True}
+    path = write_scenario(data)
+    assert main(["render", str(path), "-o", str(tmp_path / "rec"), "--sensors", "ais,nav"]) == 0
+    assert (tmp_path / "rec" / "nav" / "nav.nmea").is_file() and (tmp_path / "rec" / "ownship.jsonl").is_file()
     decoded = decode_file(tmp_path / "rec" / "ais" / "ais.nmea")
     times = [t for t, _ in decoded]
     assert times == sorted(times)
@@ -124,7 +127,7 @@ def test_render_writes_decodable_nmea_from_the_right_ships(write_scenario, tmp_p
     channels = [line.split(",")[4] for line in (tmp_path / "rec" / "ais" / "ais.nmea").read_text().splitlines()]
     assert set(channels) == {"A", "B"}
     # same inputs, same bytes
-    assert main(["render", str(path), "-o", str(tmp_path / "again"), "--sensors", "ais"]) == 0
+    assert main(["render", str(path), "-o", str(tmp_path / "again"), "--sensors", "ais,nav"]) == 0
     assert (tmp_path / "again" / "ais" / "ais.nmea").read_bytes() == (tmp_path / "rec" / "ais" / "ais.nmea").read_bytes()
 
 
