@@ -259,7 +259,7 @@ class RadarRenderer:
         if self.env.rain_mm_per_h > 0:
             total = total * self.rain_loss[None, :]
         total = total + stream(self.seed, f"radar.noise.{rev}").standard_exponential((S, N), dtype=np.float32)
-        p_db = 10.0 * np.log10(total, dtype=np.float32) + self.stc_db[None, :]
+        p_db = 10.0 * np.log10(np.maximum(total, np.float32(1e-30)), dtype=np.float32) + self.stc_db[None, :]
         if p.ftc_m > 0:
             p_db = self._ftc(p_db)
         echo = phys.quantise(p_db, p.video_floor_db, p.video_step_db)
