@@ -225,6 +225,12 @@ def render(scenario: Scenario, out_dir: Path, progress: bool | None = None) -> R
             renderer(ctx)
             wall[name] = time.perf_counter() - t0
             rendered.append(name)
+        t0 = time.perf_counter()
+        from raysim.recording.rosbag import write_rosbag
+
+        for topic, n in write_rosbag(staged.path, scenario).items():
+            ctx.counts[f"rosbag{topic}"] = n
+        wall["rosbag"] = time.perf_counter() - t0
         wall["total"] = time.perf_counter() - started
         manifest = {
             "format": "raysim-recording",

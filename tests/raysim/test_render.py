@@ -37,7 +37,7 @@ def recording(write_scenario, tmp_path):
 def test_recording_holds_the_contract_files(recording):
     names = sorted(p.name for p in recording.iterdir())
     # LiDAR and radar are off in this scenario; AIS and navigation are on by default
-    assert [n for n in names if n != "nav"] == ["ais", "manifest.json", "ownship.jsonl", "scenario.yaml", "truth.jsonl"]
+    assert names == ["ais", "manifest.json", "nav", "ownship.jsonl", "rosbag", "scenario.yaml", "truth.jsonl"]
     assert (recording / "ais" / "ais.nmea").is_file()
     manifest = json.loads((recording / "manifest.json").read_text())
     assert manifest["seed"] == 7 and manifest["duration_s"] == 5.0 and manifest["start_time"] == "2017-06-01T12:00:00Z"
