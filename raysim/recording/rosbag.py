@@ -11,6 +11,8 @@ Written with rosbags (pure Python) from the recording's own files, one message a
 | /ownship/fix | sensor_msgs/NavSatFix | ownship.jsonl |
 | /ownship/pose | geometry_msgs/PoseStamped (frame map, local ENU) | ownship.jsonl |
 | /tf_static | tf2_msgs/TFMessage: base_link -> lidar, base_link -> radar | the scenario's mounts |
+| /tf | tf2_msgs/TFMessage: map -> base_link | ownship.jsonl (10 Hz) |
+| /truth/objects | visualization_msgs/MarkerArray: a box per object | truth.jsonl (1 Hz) |
 
 Stamps are the scenario's UTC start plus each message's time; the bag's own time stamp of a
 message is its header stamp.
@@ -50,6 +52,39 @@ def _typestore():
     types.update(get_types_from_msg(NMEA_SENTENCE_MSG, "nmea_msgs/msg/Sentence"))
     store.register(types)
     return store
+
+
+_NUMPY = {"bool": np.bool_, "int8": np.int8, "uint8": np.uint8, "byte": np.uint8, "char": np.uint8,
+          "int16": np.int16, "uint16": np.uint16, "int32": np.int32, "uint32": np.uint32, "int64": np.int64,
+          "uint64": np.uint64, "float32": np.float32, "float64": np.float64}
+
+
+def _default(store, kind):
+    """Default value of a field description of the typestore (zeros, empty strings and sequences)."""
+    from rosbags.interfaces import Nodetype
+
+    node, detail = kind
+    if node == Nodetype.BASE:
+        name = detail[0]
+        return "" if name == "string" else False if name == "bool" else 0.0 if name.startswith("float") else 0
+    if node == Nodetype.NAME:
+        return make(store, detail)
+    if node == Nodetype.ARRAY:
+        (sub, size) = detail
+        if sub[0] == Nodetype.BASE and sub[1][0] in _NUMPY:
+            return np.zeros(size, dtype=_NUMPY[sub[1][0]])
+        return [_default(store, sub) for _ in range(size)]
+    sub = detail[0]
+    if sub[0] == Nodetype.BASE and sub[1][0] in _NUMPY:
+        return np.zeros(0, dtype=_NUMPY[sub[1][0]])
+    return []
+
+
+def make(store, msgtype: str, **values):
+    """A message of ``msgtype`` with the given fields and every other field at its default."""
+    _, fields = store.fielddefs[msgtype]
+    args = {name: values[name] if name in values else _default(store, kind) for name, kind in fields}
+    return store.types[msgtype](**args)
 
 
 def _stamp(store, t_ns: int):
@@ -186,7 +221,70 @@ def write_rosbag(recording: Path, scenario, out: Path | None = None) -> dict:
                             orientation=T["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=math.sin(yaw / 2),
                                                                          w=math.cos(yaw / 2))))
                     put("/ownship/pose", "geometry_msgs/msg/PoseStamped", t_ns, pose)
+                    # map -> base_link: body FLU axes from yaw, pitch (FLU: nose down positive) and roll
+                    q = _quaternion_zyx(yaw, -math.radians(row["pitch_deg"]), math.radians(row["roll_deg"]))
+                    tf = T["geometry_msgs/msg/TransformStamped"](
+                        header=_header(store, t_ns, "map"), child_frame_id="base_link",
+                        transform=T["geometry_msgs/msg/Transform"](
+                            translation=T["geometry_msgs/msg/Vector3"](x=row["x"], y=row["y"], z=row["z"]),
+                            rotation=T["geometry_msgs/msg/Quaternion"](x=q[0], y=q[1], z=q[2], w=q[3])))
+                    put("/tf", "tf2_msgs/msg/TFMessage", t_ns, T["tf2_msgs/msg/TFMessage"](transforms=[tf]))
+
+        truth = recording / "truth.jsonl"
+        if truth.is_file():
+            for t_s, rows in _truth_epochs(truth, every_s=1.0):
+                t_ns = ns(t_s)
+                markers = [_marker(store, t_ns, row) for row in rows]
+                put("/truth/objects", "visualization_msgs/msg/MarkerArray", t_ns,
+                    T["visualization_msgs/msg/MarkerArray"](markers=markers))
     return counts
+
+
+#: marker colours (r, g, b) per truth kind
+KIND_COLOURS = {"ownship": (0.2, 0.6, 1.0), "ship": (1.0, 0.4, 0.2), "iceberg": (0.85, 0.95, 1.0),
+                "buoy": (1.0, 0.85, 0.0), "mesh": (0.6, 0.6, 0.6)}
+
+
+def _truth_epochs(path: Path, every_s: float):
+    """(t, [rows]) of truth.jsonl at multiples of ``every_s``, read line by line (the file is in time order)."""
+    current, rows = None, []
+    with open(path, encoding="utf-8") as handle:
+        for line in handle:
+            row = json.loads(line)
+            if row["t"] != current:
+                if rows:
+                    yield current, rows
+                current, rows = row["t"], []
+            k = row["t"] / every_s
+            if abs(k - round(k)) < 1e-6:
+                rows.append(row)
+    if rows:
+        yield current, rows
+
+
+def _marker(store, t_ns: int, row: dict):
+    """A CUBE of the object's length, beam and height at its truth pose (frame map), text = its name."""
+    T = store.types
+    yaw = math.radians(90.0 - row["heading_deg"])
+    r, g, b = KIND_COLOURS.get(row["kind"], (0.6, 0.6, 0.6))
+    return make(store, "visualization_msgs/msg/Marker", header=_header(store, t_ns, "map"), ns=row["kind"], id=int(row["id"]),
+                type=1, action=0,
+                pose=T["geometry_msgs/msg/Pose"](
+                    position=T["geometry_msgs/msg/Point"](x=row["x"], y=row["y"], z=row["height_m"] / 2.0),
+                    orientation=T["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=math.sin(yaw / 2), w=math.cos(yaw / 2))),
+                scale=T["geometry_msgs/msg/Vector3"](x=max(row["length_m"], 0.1), y=max(row["beam_m"], 0.1),
+                                                     z=max(row["height_m"], 0.1)),
+                color=T["std_msgs/msg/ColorRGBA"](r=r, g=g, b=b, a=0.6), lifetime=_duration(store, 1.5),
+                text=row["name"])
+
+
+def _quaternion_zyx(yaw_rad: float, pitch_rad: float, roll_rad: float) -> tuple[float, float, float, float]:
+    """(x, y, z, w) of the rotation yaw about z, then pitch about y, then roll about x (intrinsic)."""
+    cy, sy = math.cos(yaw_rad / 2), math.sin(yaw_rad / 2)
+    cp, sp = math.cos(pitch_rad / 2), math.sin(pitch_rad / 2)
+    cr, sr = math.cos(roll_rad / 2), math.sin(roll_rad / 2)
+    return (sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy,
+            cr * cp * cy + sr * sp * sy)
 
 
 def _quaternion(rot: np.ndarray) -> tuple[float, float, float, float]:

@@ -42,7 +42,8 @@ def test_bag_topics_and_counts_match_the_recording(recording):
     bag = messages(recording)
     manifest = json.loads((recording / "manifest.json").read_text())
     start = 1496318400.0  # 2017-06-01T12:00:00Z, busy_open_sea's start
-    assert set(bag) == {"/tf_static", "/lidar/points", "/radar/sector", "/ais/nmea", "/ownship/fix", "/ownship/pose"}
+    assert set(bag) == {"/tf_static", "/tf", "/lidar/points", "/radar/sector", "/ais/nmea", "/ownship/fix",
+                        "/ownship/pose", "/truth/objects"}
     for topic, msgs in bag.items():
         assert manifest["counts"][f"rosbag{topic}"] == len(msgs)
     meta = yaml.safe_load((recording / "rosbag" / "metadata.yaml").read_text())
@@ -83,3 +84,24 @@ def test_bag_topics_and_counts_match_the_recording(recording):
     assert (fix.latitude, fix.longitude) == (own[0]["lat"], own[0]["lon"])
     frames = {t.child_frame_id for t in bag["/tf_static"][0].transforms}
     assert frames == {"lidar", "radar"}
+
+
+def test_bag_carries_the_own_ship_transform_and_truth_boxes(recording):
+    bag = messages(recording)
+    own = [json.loads(line) for line in (recording / "ownship.jsonl").read_text().splitlines()]
+    tf = bag["/tf"][5].transforms[0]
+    row = next(r for r in own if abs(r["t"] - (stamp_s(tf) - 1496318400.0)) < 1e-6)
+    assert (tf.header.frame_id, tf.child_frame_id) == ("map", "base_link")
+    assert (tf.transform.translation.x, tf.transform.translation.y) == (row["x"], row["y"])
+    q = tf.transform.rotation
+    yaw = np.arctan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y**2 + q.z**2))
+    assert (90.0 - np.degrees(yaw)) % 360.0 == pytest.approx(row["heading_deg"], abs=1e-6)
+    truth = [json.loads(line) for line in (recording / "truth.jsonl").read_text().splitlines()]
+    boxes = bag["/truth/objects"]
+    assert len(boxes) == 4  # t = 0, 1, 2, 3 s
+    at_two = {r["id"]: r for r in truth if r["t"] == 2.0}
+    markers = boxes[2].markers
+    assert {m.id for m in markers} == set(at_two)
+    ship = next(m for m in markers if at_two[m.id]["kind"] == "ship")
+    assert (ship.pose.position.x, ship.scale.x, ship.text) == (at_two[ship.id]["x"], at_two[ship.id]["length_m"],
+                                                               at_two[ship.id]["name"])
