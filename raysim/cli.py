@@ -156,7 +156,7 @@ def cmd_import_hilsim(args) -> int:
     return 0
 
 
-BENCHMARKS = ("ray_engine", "lidar", "radar")
+BENCHMARKS = ("ray_engine", "lidar", "radar", "rosbag")
 
 
 def cmd_bench(args) -> int:
