@@ -52,6 +52,16 @@ def _sensors(text: str) -> tuple[str, ...]:
     return names
 
 
+def _formats(text: str) -> tuple[str, ...]:
+    from raysim.recording.pointclouds import FORMATS
+
+    names = tuple(n.strip() for n in text.split(",") if n.strip())
+    for name in names:
+        if name not in FORMATS:
+            raise InputError("command line", "--formats", f"unknown format {name!r} (known: {', '.join(FORMATS)})")
+    return names
+
+
 def _route(text: str) -> list[list[float]]:
     points = []
     for part in text.split(";"):
@@ -75,6 +85,8 @@ def build_parser() -> argparse.ArgumentParser:
         p.add_argument("--seed", type=_seed, help="override the seed")
         if sensors:
             p.add_argument("--sensors", type=_sensors, help="comma-separated subset of lidar,radar,ais,nav")
+        p.add_argument("--formats", type=_formats, default=(),
+                       help="extra LiDAR point-cloud files: comma-separated pcd,kitti")
         p.add_argument("--no-progress", action="store_true", help="no progress bars")
 
     common(sub.add_parser("render", help="render a scenario into a recording directory"), sensors=True)
@@ -112,7 +124,8 @@ def cmd_render(args) -> int:
     from raysim.render import render
 
     scenario = _load(args)
-    result = render(scenario, _out_dir(args, scenario), progress=False if args.no_progress else None)
+    result = render(scenario, _out_dir(args, scenario), progress=False if args.no_progress else None,
+                    formats=args.formats)
     _summary(result)
     return 0
 

@@ -185,7 +185,7 @@ def _versions() -> dict:
     return versions
 
 
-def render(scenario: Scenario, out_dir: Path, progress: bool | None = None) -> RenderResult:
+def render(scenario: Scenario, out_dir: Path, progress: bool | None = None, formats: tuple[str, ...] = ()) -> RenderResult:
     """Render ``scenario`` into ``out_dir``; all or nothing.
 
     Parameters
@@ -196,6 +196,8 @@ def render(scenario: Scenario, out_dir: Path, progress: bool | None = None) -> R
         Recording directory; replaced if it holds an older recording.
     progress : bool, optional
         Show progress bars; default: when stderr is a terminal.
+    formats : tuple of str
+        Extra point-cloud files from the LiDAR sweeps (:data:`raysim.recording.pointclouds.FORMATS`).
     """
     if progress is None:
         progress = sys.stderr.isatty()
@@ -231,6 +233,10 @@ def render(scenario: Scenario, out_dir: Path, progress: bool | None = None) -> R
         for topic, n in write_rosbag(staged.path, scenario).items():
             ctx.counts[f"rosbag{topic}"] = n
         wall["rosbag"] = time.perf_counter() - t0
+        if formats:
+            from raysim.recording.pointclouds import write_point_cloud_files
+
+            ctx.counts.update(write_point_cloud_files(staged.path, tuple(formats)))
         wall["total"] = time.perf_counter() - started
         manifest = {
             "format": "raysim-recording",
