@@ -233,6 +233,10 @@ def render(scenario: Scenario, out_dir: Path, progress: bool | None = None, form
         for topic, n in write_rosbag(staged.path, scenario).items():
             ctx.counts[f"rosbag{topic}"] = n
         wall["rosbag"] = time.perf_counter() - t0
+        from raysim.recording.map_picture import write_map
+
+        write_map(staged.path)
+        ctx.counts["map.png"] = 1
         if formats:
             from raysim.recording.pointclouds import write_point_cloud_files
 

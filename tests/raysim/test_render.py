@@ -37,7 +37,7 @@ def recording(write_scenario, tmp_path):
 def test_recording_holds_the_contract_files(recording):
     names = sorted(p.name for p in recording.iterdir())
     # LiDAR and radar are off in this scenario; AIS and navigation are on by default
-    assert names == ["ais", "manifest.json", "nav", "ownship.jsonl", "rosbag", "scenario.yaml", "truth.jsonl"]
+    assert names == ["ais", "manifest.json", "map.png", "nav", "ownship.jsonl", "rosbag", "scenario.yaml", "truth.jsonl"]
     assert (recording / "ais" / "ais.nmea").is_file()
     manifest = json.loads((recording / "manifest.json").read_text())
     assert manifest["seed"] == 7 and manifest["duration_s"] == 5.0 and manifest["start_time"] == "2017-06-01T12:00:00Z"
@@ -173,3 +173,14 @@ def test_bad_trajectory_csv(content, where, write_scenario, tmp_path, capsys):
     assert code == 2
     assert f": {where}: " in err and err.count("\n") == 1, err
     assert not (tmp_path / "rec").exists()
+
+
+def test_map_shows_the_run_from_above(recording):
+    from PIL import Image
+
+    from raysim.recording.map_picture import COLOURS
+
+    image = np.asarray(Image.open(recording / "map.png").convert("RGB"))
+    assert image.shape == (1000, 1000, 3)
+    for kind in ("ownship", "ship", "iceberg", "buoy"):  # every kind of object of the scenario is drawn
+        assert np.all(image == np.array(COLOURS[kind]), axis=-1).sum() > 5, kind
