@@ -237,6 +237,10 @@ def render(scenario: Scenario, out_dir: Path, progress: bool | None = None, form
 
         write_map(staged.path)
         ctx.counts["map.png"] = 1
+        if (staged.path / "lidar" / "sweeps").is_dir():
+            from raysim.recording.bev import write_bev
+
+            ctx.counts["lidar/bev"] = write_bev(staged.path, scenario)
         if formats:
             from raysim.recording.pointclouds import write_point_cloud_files
 

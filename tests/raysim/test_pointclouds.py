@@ -25,5 +25,16 @@ def test_pcd_and_kitti_files_hold_the_sweeps(tmp_path, capsys):
         kitti = np.fromfile(out / "lidar" / "kitti" / f"{sweeps[2].stem}.bin", dtype="<f4").reshape(-1, 4)
         np.testing.assert_array_equal(kitti[:, :3], xyz)
         np.testing.assert_allclose(kitti[:, 3], sweep["intensity"] / 255.0, rtol=1e-6)
+    # bird's-eye pictures: one per second of sweeps, with points drawn where the NPZ puts them
+    from PIL import Image
+
+    bev = sorted((out / "lidar" / "bev").glob("*.png"))
+    assert [p.stem for p in bev] == [sweeps[0].stem]
+    image = np.asarray(Image.open(bev[0]).convert("RGB"))
+    with np.load(sweeps[0]) as sweep:
+        near = (np.abs(sweep["x"]) < 99) & (np.abs(sweep["y"]) < 99)
+        rows = np.floor(400 - sweep["x"][near] * 4).astype(int)
+        cols = np.floor(400 - sweep["y"][near] * 4).astype(int)
+    assert image.shape == (800, 800, 3) and (image[rows, cols].sum(axis=1) > 0).mean() > 0.99
     assert main(args + ["--formats", "ply"]) == 2
     assert "--formats" in capsys.readouterr().err

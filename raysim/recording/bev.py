@@ -1,0 +1,93 @@
+"""``lidar/bev/NNNNNN.png``: bird's-eye pictures of LiDAR sweeps with the truth outlines.
+
+One picture per second of scenario (every ``rotation_hz``-th sweep, named after it), 800 x 800
+pixels for +-100 m around the sensor (the HDL-32E's range), sensor frame with x (forward) up:
+points coloured by intensity (dark blue 0 to yellow 255), each object's truth box (length x beam at
+its truth pose at the sweep's first point, in the own ship's level frame) outlined in red.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+from PIL import Image, ImageDraw
+
+from raysim.recording.staging import atomic_path
+
+__all__ = ["write_bev"]
+
+SIZE_PX = 800
+HALF_RANGE_M = 100.0
+
+
+def _colour(intensity: np.ndarray) -> np.ndarray:
+    """(N, 3) uint8: dark blue (0) through green to yellow (255)."""
+    v = np.clip(intensity.astype(np.float32) / 255.0, 0.0, 1.0) ** 0.5
+    return np.stack([255 * v, 80 + 175 * v, 200 * (1 - v) + 30], axis=1).astype(np.uint8)
+
+
+def _truth_at(truth: Path, times: set) -> dict:
+    """{t: [rows]} of truth.jsonl at the given times (multiples of 0.1 s), read line by line."""
+    out: dict[float, list] = {}
+    with open(truth, encoding="utf-8") as handle:
+        for line in handle:
+            t = float(line[6:line.index(",")])
+            if t in times:
+                out.setdefault(t, []).append(json.loads(line))
+    return out
+
+
+def write_bev(recording: Path, scenario) -> int:
+    """Draw the bird's-eye pictures of ``recording``; returns how many."""
+    recording = Path(recording)
+    sweeps = sorted((recording / "lidar" / "sweeps").glob("*.npz"))
+    every = max(1, int(round(scenario.sensors.lidar.rotation_hz)))
+    chosen = sweeps[::every]
+    if not chosen:
+        return 0
+    starts = {}
+    for path in chosen:
+        with np.load(path) as sweep:
+            starts[path] = round(float(sweep["time"].min()) * 10.0) / 10.0 if sweep["time"].size else 0.0
+    truth = _truth_at(recording / "truth.jsonl", set(starts.values()))
+    mount = scenario.sensors.lidar.mount
+    folder = recording / "lidar" / "bev"
+    folder.mkdir(parents=True, exist_ok=True)
+    scale = SIZE_PX / (2 * HALF_RANGE_M)
+    for path in chosen:
+        with np.load(path) as sweep:
+            x, y, intensity = sweep["x"], sweep["y"], sweep["intensity"]
+        image = np.zeros((SIZE_PX, SIZE_PX, 3), dtype=np.uint8)
+        col = np.floor(SIZE_PX / 2 - y * scale).astype(np.int64)  # y (left) to the left
+        row = np.floor(SIZE_PX / 2 - x * scale).astype(np.int64)  # x (forward) up
+        ok = (col >= 0) & (col < SIZE_PX) & (row >= 0) & (row < SIZE_PX)
+        order = np.argsort(intensity[ok], kind="stable")  # brightest drawn last
+        image[row[ok][order], col[ok][order]] = _colour(intensity[ok][order])
+        picture = Image.fromarray(image)
+        draw = ImageDraw.Draw(picture)
+        rows = truth.get(starts[path], [])
+        own = next((r for r in rows if r["kind"] == "ownship"), None)
+        if own is not None:
+            psi = math.radians(90.0 - own["heading_deg"]) + math.radians(mount.yaw_deg)  # sensor x in the world
+            c, s = math.cos(psi), math.sin(psi)
+            ox = own["x"] + mount.x_m * math.cos(psi) - mount.y_m * math.sin(psi)
+            oy = own["y"] + mount.x_m * math.sin(psi) + mount.y_m * math.cos(psi)
+            for r in rows:
+                if r["kind"] == "ownship":
+                    continue
+                a = math.radians(90.0 - r["heading_deg"])
+                corners = []
+                for u, v in ((1, 1), (1, -1), (-1, -1), (-1, 1)):
+                    wx = r["x"] + u * r["length_m"] / 2 * math.cos(a) - v * r["beam_m"] / 2 * math.sin(a)
+                    wy = r["y"] + u * r["length_m"] / 2 * math.sin(a) + v * r["beam_m"] / 2 * math.cos(a)
+                    sx = (wx - ox) * c + (wy - oy) * s
+                    sy = -(wx - ox) * s + (wy - oy) * c
+                    corners.append((SIZE_PX / 2 - sy * scale, SIZE_PX / 2 - sx * scale))
+                draw.polygon(corners, outline=(255, 40, 40))
+        draw.text((6, 6), f"t = {starts[path]:.1f} s, +-{HALF_RANGE_M:g} m, forward up", fill=(200, 200, 200))
+        with atomic_path(folder / f"{path.stem}.png") as tmp:
+            picture.save(tmp, format="PNG")
+    return len(chosen)
