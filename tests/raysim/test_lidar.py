@@ -277,7 +277,7 @@ def test_same_seed_same_bytes(write_scenario, tmp_path):
     a = render(write_scenario, tmp_path, data, "a")
     b = render(write_scenario, tmp_path, data, "b")
     files = sorted(p.relative_to(a) for p in (a / "lidar").rglob("*") if p.is_file())
-    assert len(files) == 3  # the PCAP and two sweeps
+    assert len(files) == 4  # the PCAP, two sweeps and a bird's-eye picture
     for rel in files:
         assert (a / rel).read_bytes() == (b / rel).read_bytes(), rel
     data["seed"] = 4
