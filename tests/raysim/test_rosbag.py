@@ -105,3 +105,10 @@ def test_bag_carries_the_own_ship_transform_and_truth_boxes(recording):
     ship = next(m for m in markers if at_two[m.id]["kind"] == "ship")
     assert (ship.pose.position.x, ship.scale.x, ship.text) == (at_two[ship.id]["x"], at_two[ship.id]["length_m"],
                                                                at_two[ship.id]["name"])
+
+
+def test_the_bag_is_deterministic(recording, tmp_path):
+    again = tmp_path / "again"
+    assert main(["render", str(REPO / "scenarios" / "busy_open_sea.yaml"), "-o", str(again), "--duration", "3"]) == 0
+    for name in ("rosbag.mcap", "metadata.yaml"):
+        assert (again / "rosbag" / name).read_bytes() == (recording / "rosbag" / name).read_bytes()
