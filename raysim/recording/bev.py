@@ -8,13 +8,13 @@ its truth pose at the sweep's first point, in the own ship's level frame) outlin
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 
 import numpy as np
 from PIL import Image, ImageDraw
 
+from raysim.recording.jsonl import truth_epochs
 from raysim.recording.staging import atomic_path
 
 __all__ = ["write_bev"]
@@ -29,17 +29,6 @@ def _colour(intensity: np.ndarray) -> np.ndarray:
     return np.stack([255 * v, 80 + 175 * v, 200 * (1 - v) + 30], axis=1).astype(np.uint8)
 
 
-def _truth_at(truth: Path, times: set) -> dict:
-    """{t: [rows]} of truth.jsonl at the given times (multiples of 0.1 s), read line by line."""
-    out: dict[float, list] = {}
-    with open(truth, encoding="utf-8") as handle:
-        for line in handle:
-            t = float(line[6:line.index(",")])
-            if t in times:
-                out.setdefault(t, []).append(json.loads(line))
-    return out
-
-
 def write_bev(recording: Path, scenario) -> int:
     """Draw the bird's-eye pictures of ``recording``; returns how many."""
     recording = Path(recording)
@@ -52,7 +41,8 @@ def write_bev(recording: Path, scenario) -> int:
     for path in chosen:
         with np.load(path) as sweep:
             starts[path] = round(float(sweep["time"].min()) * 10.0) / 10.0 if sweep["time"].size else 0.0
-    truth = _truth_at(recording / "truth.jsonl", set(starts.values()))
+    wanted = set(starts.values())
+    truth = dict(truth_epochs(recording / "truth.jsonl", wanted.__contains__))
     mount = scenario.sensors.lidar.mount
     folder = recording / "lidar" / "bev"
     folder.mkdir(parents=True, exist_ok=True)

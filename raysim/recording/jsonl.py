@@ -7,7 +7,7 @@ bytes: times 4 decimals (s), lat/lon 9 (deg, 0.1 mm), metres 3, degrees 3, m/s 3
 from __future__ import annotations
 
 import json
-from typing import IO, Sequence
+from typing import IO, Iterator, Sequence
 
 import numpy as np
 
@@ -72,3 +72,37 @@ def write_ownship_chunk(handle: IO[str], t_s: np.ndarray, c: dict) -> int:
     ]
     handle.write("".join(lines))
     return len(lines)
+
+
+def every(period_s: float):
+    """Predicate for :func:`truth_epochs`: times that are whole multiples of ``period_s``."""
+
+    def keep(t_s: float) -> bool:
+        k = t_s / period_s
+        return abs(k - round(k)) < 1e-6
+
+    return keep
+
+
+def truth_epochs(path, keep) -> "Iterator[tuple[float, list[dict]]]":
+    """The rows of a truth.jsonl file, grouped by time, for the times ``keep(t)`` accepts.
+
+    Read line by line (the file is in time order, each line starts with its ``"t"``), so memory
+    holds one epoch; only the kept lines are parsed.
+
+    Yields
+    ------
+    (t_s, rows) : (float, list of dict)
+    """
+    current, rows, kept = None, [], False
+    with open(path, encoding="utf-8") as handle:
+        for line in handle:
+            t = float(line[6 : line.index(",")])  # '{"t": 12.3000, ...'
+            if t != current:
+                if rows:
+                    yield current, rows
+                current, rows, kept = t, [], keep(t)
+            if kept:
+                rows.append(json.loads(line))
+    if rows:
+        yield current, rows

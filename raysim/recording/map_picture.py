@@ -7,13 +7,13 @@ scale bar and the own ship's start and end. Drawn from ``truth.jsonl``, read lin
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 
 import numpy as np
 from PIL import Image, ImageDraw
 
+from raysim.recording.jsonl import every, truth_epochs
 from raysim.recording.staging import atomic_path
 
 __all__ = ["write_map"]
@@ -26,12 +26,8 @@ COLOURS = {"ownship": (60, 140, 255), "ship": (255, 140, 40), "iceberg": (235, 2
 
 def _read_tracks(truth: Path, every_s: float = 1.0) -> dict:
     tracks: dict[int, dict] = {}
-    with open(truth, encoding="utf-8") as handle:
-        for line in handle:
-            row = json.loads(line)
-            k = row["t"] / every_s
-            if abs(k - round(k)) > 1e-6:
-                continue
+    for _, rows in truth_epochs(truth, every(every_s)):
+        for row in rows:
             track = tracks.setdefault(row["id"], {"name": row["name"], "kind": row["kind"], "beam_m": row["beam_m"],
                                                   "xy": []})
             track["xy"].append((row["x"], row["y"]))

@@ -17,15 +17,19 @@ import numpy as np
 
 from raysim.recording.staging import atomic_path
 
-__all__ = ["FORMATS", "pcd_bytes", "kitti_bytes", "write_point_cloud_files"]
+__all__ = ["FORMATS", "PCD_DTYPE", "velodyne_points", "pcd_bytes", "kitti_bytes", "write_point_cloud_files"]
 
 FORMATS = ("pcd", "kitti")
 
 PCD_DTYPE = np.dtype([("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("intensity", "<f4"), ("ring", "<u2"), ("time", "<f4")])
 
 
-def pcd_bytes(sweep) -> bytes:
-    """Binary PCD v0.7 of one sweep (the NPZ arrays)."""
+def velodyne_points(sweep) -> np.ndarray:
+    """(N,) packed points of one sweep (the NPZ arrays) in the velodyne driver's XYZIRT layout.
+
+    Fields x, y, z, intensity (float32), ring (uint16), time (float32, s since the sweep's first
+    point): 22 bytes a point, as ROS PointCloud2 (/lidar/points) and the PCD files carry them.
+    """
     n = sweep["x"].size
     points = np.empty(n, dtype=PCD_DTYPE)
     points["x"], points["y"], points["z"] = sweep["x"], sweep["y"], sweep["z"]
@@ -33,6 +37,13 @@ def pcd_bytes(sweep) -> bytes:
     points["ring"] = sweep["ring"].astype(np.uint16)
     t = np.asarray(sweep["time"], dtype=np.float64)
     points["time"] = (t - t.min()).astype(np.float32) if n else t.astype(np.float32)
+    return points
+
+
+def pcd_bytes(sweep) -> bytes:
+    """Binary PCD v0.7 of one sweep (the NPZ arrays)."""
+    points = velodyne_points(sweep)
+    n = points.size
     header = (
         "# .PCD v0.7 - Point Cloud Data file format (raysim)\n"
         "VERSION 0.7\nFIELDS x y z intensity ring time\nSIZE 4 4 4 4 2 4\nTYPE F F F F U F\nCOUNT 1 1 1 1 1 1\n"

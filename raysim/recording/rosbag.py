@@ -26,6 +26,9 @@ from pathlib import Path
 
 import numpy as np
 
+from raysim.recording.jsonl import every, truth_epochs
+from raysim.recording.pointclouds import PCD_DTYPE, velodyne_points
+
 __all__ = ["write_rosbag", "RADAR_SECTOR_MSG", "RADAR_ECHO_MSG", "NMEA_SENTENCE_MSG", "POINT_STEP"]
 
 RADAR_ECHO_MSG = "float32[] echoes\n"
@@ -39,7 +42,7 @@ float32 range_max
 marine_sensor_msgs/RadarEcho[] intensities
 """
 NMEA_SENTENCE_MSG = "std_msgs/Header header\nstring sentence\n"
-POINT_STEP = 22  # velodyne_pointcloud XYZIRT: 4 x float32, uint16 ring, float32 time
+POINT_STEP = PCD_DTYPE.itemsize  # velodyne_pointcloud XYZIRT: 4 x float32, uint16 ring, float32 time: 22
 
 
 def _typestore():
@@ -103,20 +106,6 @@ def _duration(store, seconds: float):
     return Duration(sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000)
 
 
-def point_cloud_bytes(sweep) -> tuple[bytes, int]:
-    """Packed velodyne XYZIRT points of one sweep (NPZ arrays) and their count; time relative to the sweep start."""
-    n = sweep["x"].size
-    dtype = np.dtype([("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("intensity", "<f4"), ("ring", "<u2"), ("time", "<f4")])
-    assert dtype.itemsize == POINT_STEP
-    packed = np.empty(n, dtype=dtype)
-    packed["x"], packed["y"], packed["z"] = sweep["x"], sweep["y"], sweep["z"]
-    packed["intensity"] = sweep["intensity"].astype(np.float32)
-    packed["ring"] = sweep["ring"].astype(np.uint16)
-    t = sweep["time"]
-    packed["time"] = (t - t.min()).astype(np.float32) if n else t.astype(np.float32)
-    return packed.tobytes(), n
-
-
 def write_rosbag(recording: Path, scenario, out: Path | None = None) -> dict:
     """Write ``recording/rosbag`` (or ``out``) from the recording's files; returns message counts per topic.
 
@@ -168,11 +157,12 @@ def write_rosbag(recording: Path, scenario, out: Path | None = None) -> dict:
                                   ("time", 18, 7))]
         for path in sorted((recording / "lidar" / "sweeps").glob("*.npz")):
             with np.load(path) as sweep:
-                data, n = point_cloud_bytes(sweep)
+                points = velodyne_points(sweep)
+                n = points.size
                 t_ns = ns(float(sweep["time"].min()) if n else 0.0)
             msg = T["sensor_msgs/msg/PointCloud2"](
                 header=_header(store, t_ns, "lidar"), height=1, width=n, fields=fields, is_bigendian=False,
-                point_step=POINT_STEP, row_step=POINT_STEP * n, data=np.frombuffer(data, dtype=np.uint8), is_dense=True)
+                point_step=POINT_STEP, row_step=POINT_STEP * n, data=points.view(np.uint8), is_dense=True)
             put("/lidar/points", "sensor_msgs/msg/PointCloud2", t_ns, msg)
 
         Echo = T["marine_sensor_msgs/msg/RadarEcho"]
@@ -232,7 +222,7 @@ def write_rosbag(recording: Path, scenario, out: Path | None = None) -> dict:
 
         truth = recording / "truth.jsonl"
         if truth.is_file():
-            for t_s, rows in _truth_epochs(truth, every_s=1.0):
+            for t_s, rows in truth_epochs(truth, every(1.0)):
                 t_ns = ns(t_s)
                 markers = [_marker(store, t_ns, row) for row in rows]
                 put("/truth/objects", "visualization_msgs/msg/MarkerArray", t_ns,
@@ -243,23 +233,6 @@ def write_rosbag(recording: Path, scenario, out: Path | None = None) -> dict:
 #: marker colours (r, g, b) per truth kind
 KIND_COLOURS = {"ownship": (0.2, 0.6, 1.0), "ship": (1.0, 0.4, 0.2), "iceberg": (0.85, 0.95, 1.0),
                 "buoy": (1.0, 0.85, 0.0), "mesh": (0.6, 0.6, 0.6)}
-
-
-def _truth_epochs(path: Path, every_s: float):
-    """(t, [rows]) of truth.jsonl at multiples of ``every_s``, read line by line (the file is in time order)."""
-    current, rows = None, []
-    with open(path, encoding="utf-8") as handle:
-        for line in handle:
-            row = json.loads(line)
-            if row["t"] != current:
-                if rows:
-                    yield current, rows
-                current, rows = row["t"], []
-            k = row["t"] / every_s
-            if abs(k - round(k)) < 1e-6:
-                rows.append(row)
-    if rows:
-        yield current, rows
 
 
 def _marker(store, t_ns: int, row: dict):

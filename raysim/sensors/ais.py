@@ -73,10 +73,6 @@ def _kinematics(obj, t: np.ndarray) -> dict:
             "heading_deg": heading, "rot_deg_per_min": rot}
 
 
-def _interp(grid: np.ndarray, values: np.ndarray, t: np.ndarray) -> np.ndarray:
-    return np.interp(t, grid, values)
-
-
 def ship_messages(world, obj, ship_cfg) -> list[AisMessage]:
     """Every message the transponder of ``obj`` transmits during the run (before reception).
 
@@ -112,28 +108,28 @@ def ship_messages(world, obj, ship_cfg) -> list[AisMessage]:
     def err(name, var_w, var_b, tau):
         return white_plus_bias(stream(s.seed, f"ais.{mmsi}.{name}"), t, math.sqrt(var_w), math.sqrt(var_b), tau)
 
-    east = _interp(grid, kin["x"], t) + cfg.position_offset_m[0] + err(
+    east = np.interp(t, grid, kin["x"]) + cfg.position_offset_m[0] + err(
         "position_east", noise.position_measure_variance_m2, noise.position_bias_variance_m2,
         noise.position_bias_time_constant_sec)
-    north = _interp(grid, kin["y"], t) + cfg.position_offset_m[1] + err(
+    north = np.interp(t, grid, kin["y"]) + cfg.position_offset_m[1] + err(
         "position_north", noise.position_measure_variance_m2, noise.position_bias_variance_m2,
         noise.position_bias_time_constant_sec)
     lat, lon = world.frame.to_geodetic(east, north)
-    sog = _interp(grid, kin["sog_kn"], t) + err("sog", noise.sog_measure_variance_knots2, noise.sog_bias_variance_knots2,
+    sog = np.interp(t, grid, kin["sog_kn"]) + err("sog", noise.sog_measure_variance_knots2, noise.sog_bias_variance_knots2,
                                                  noise.sog_bias_time_constant_sec)
     cog_true = np.degrees(np.unwrap(np.radians(kin["cog_deg"])))
-    cog = _interp(grid, cog_true, t) + err("cog", noise.cog_measure_variance_deg2, noise.cog_bias_variance_deg2,
+    cog = np.interp(t, grid, cog_true) + err("cog", noise.cog_measure_variance_deg2, noise.cog_bias_variance_deg2,
                                            noise.cog_bias_time_constant_sec)
     hdg_true = np.degrees(np.unwrap(np.radians(kin["heading_deg"])))
-    heading = _interp(grid, hdg_true, t) + err("heading", noise.track_measure_variance_deg2,
+    heading = np.interp(t, grid, hdg_true) + err("heading", noise.track_measure_variance_deg2,
                                                noise.track_bias_variance_deg2, noise.track_bias_time_constant_sec)
-    rot = _interp(grid, kin["rot_deg_per_min"], t) + err("rot", noise.rot_measure_variance_deg2_pr_min2,
+    rot = np.interp(t, grid, kin["rot_deg_per_min"]) + err("rot", noise.rot_measure_variance_deg2_pr_min2,
                                                          noise.rot_bias_variance_deg2_pr_min2,
                                                          noise.rot_bias_time_constant_sec)
     accuracy = math.sqrt(noise.position_measure_variance_m2 + noise.position_bias_variance_m2) <= 10.0
     start = s.start_time
     seconds = np.floor((start.second + start.microsecond * 1e-6 + t) % 60.0)
-    iv = _interp(grid, interval, t)
+    iv = np.interp(t, grid, interval)
     rate_changed = np.concatenate([[False], np.abs(np.diff(iv)) > 1e-6])
 
     messages = []

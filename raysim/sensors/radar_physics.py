@@ -15,6 +15,8 @@ import math
 import numpy as np
 from scipy.special import gammaincinv, ndtr
 
+from raysim.scenario import DOUGLAS_WAVE_HEIGHT_M
+
 # ------------------------------------------------------------------ constants
 
 C_MPS = 299_792_458.0  # speed of light
@@ -301,9 +303,9 @@ def flat_plate_rcs_m2(area_m2: float, f_ghz: float = FREQUENCY_GHZ) -> float:
 
 # ------------------------------------------------------------------ multipath (REF 3.5)
 
-# Significant wave height of each Douglas sea state 0..6, m: the middle of the WMO code 3700 bands
-# (0, 0-0.1, 0.1-0.5, 0.5-1.25, 1.25-2.5, 2.5-4, 4-6 m); rms surface height = Hs / 4.
-SEA_STATE_HS_M = (0.0, 0.05, 0.3, 0.875, 1.875, 3.25, 5.0)
+# Significant wave height of each Douglas sea state 0..6, m: the middle of its WMO code 3700 band
+# (raysim.scenario.DOUGLAS_WAVE_HEIGHT_M holds the bands' upper bounds); rms surface height = Hs / 4.
+SEA_STATE_HS_M = tuple((lo + hi) / 2.0 for lo, hi in zip((0.0,) + DOUGLAS_WAVE_HEIGHT_M[:-1], DOUGLAS_WAVE_HEIGHT_M))
 
 
 def ament_factor(sea_state: int, sin_grazing, f_ghz: float = FREQUENCY_GHZ):

@@ -117,7 +117,7 @@ def test_nrl_level_of_the_clutter_for_a_clean_geometry(tmp_path):
 
 def test_rain_attenuates_far_echoes_by_the_itu_two_way_loss(tmp_path):
     target = hull(tmp_path, "far", 0.0, 1700.0, length=30.0, height=6.0)
-    peaks_db, echoes = [], []
+    peaks_db = []
     for rain, name in ((0.0, "dry"), (50.0, "wet")):
         renderer, _ = radar_world(tmp_path, obstacles=[target], name=name,
                                   environment={"sea_state": 0, "wind_speed_mps": 0, "rain_mm_per_h": rain}, range_m=1852.0)
