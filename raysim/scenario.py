@@ -285,12 +285,20 @@ def _periods_check(value) -> str | None:
     return None
 
 
-def _ais_text_check(value: str) -> str | None:
-    allowed = set("@ABCDEFGHIJKLMNOPQRSTUVWXYZ[\\]^_ !\"#$%&'()*+,-./0123456789:;<=>?")
-    bad = sorted({c for c in value.upper() if c not in allowed})
-    if bad:
-        return f"characters {''.join(bad)!r} are not in the AIS 6-bit character set"
-    return None
+def _ais_text(limit: int):
+    """Check of an AIS text field: the 6-bit character set and at most ``limit`` characters."""
+
+    def check(value: str) -> str | None:
+        from raysim.sensors.ais_fields import AIS_CHARS
+
+        bad = sorted({c for c in value.upper() if c not in AIS_CHARS})
+        if bad:
+            return f"characters {''.join(bad)!r} are not in the AIS 6-bit character set"
+        if len(value) > limit:
+            return f"at most {limit} characters, got {len(value)}"
+        return None
+
+    return check
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -299,12 +307,12 @@ class ShipAis:
     mmsi: int = param(doc="Maritime Mobile Service Identity, 9 digits", check=_mmsi_check)
     ais_class: Literal["A", "B"] = param("A", doc="Transponder class: A (types 1/3 and 5) or B (types 18 and 24)")
     name: str | None = param(None, doc="Vessel name, up to 20 characters", default_doc="the ship's name, upper case",
-                             check=_ais_text_check)
-    call_sign: str | None = param(None, doc="Call sign, up to 7 characters; null: not available", check=_ais_text_check)
+                             check=_ais_text(20))
+    call_sign: str | None = param(None, doc="Call sign, up to 7 characters; null: not available", check=_ais_text(7))
     ship_type: int | None = param(None, doc="ITU ship and cargo type, 0..99", ge=0, le=99,
                                   default_doc="70 (cargo) for class A, 37 (pleasure craft) for class B")
     draught_m: float | None = param(None, doc="Draught, m", ge=0, le=25.5, default_doc="0.06 x length_m, at most 25.5")
-    destination: str | None = param(None, doc="Destination, up to 20 characters; null: not available", check=_ais_text_check)
+    destination: str | None = param(None, doc="Destination, up to 20 characters; null: not available", check=_ais_text(20))
     nav_status: Literal["auto", "under_way", "at_anchor", "moored"] = param(
         "auto", doc="Navigation status; auto: at anchor when anchored, else under way using engine")
     antenna_height_m: float | None = param(None, doc="Transmitting antenna height above the sea, m", gt=0, le=100,

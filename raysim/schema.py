@@ -206,12 +206,12 @@ def build(cls: type, data: Any, ctx: Context, path: str = "") -> Any:
     fields = {f.name: f for f in dataclasses.fields(cls) if f.init}
     alias_of = {a: f.name for f in fields.values() for a in f.metadata.get("aliases", ())}
     if alias_of and any(key in alias_of for key in data):
-        renamed = {}
+        renamed, given_as = {}, {}
         for key, value in data.items():
             name = alias_of.get(key, key)
             if name in renamed:
-                ctx.fail(_child(path, str(key)), f"given twice (as {name} and as {key})")
-            renamed[name] = value
+                ctx.fail(_child(path, str(key)), f"given twice (as {given_as[name]} and as {key})")
+            renamed[name], given_as[name] = value, key
         data = renamed
     for key in data:
         if key not in fields:

@@ -81,6 +81,12 @@ BAD = [
     ("unknown top-level key", lambda d: d.update(durration_s=3), "durration_s", "unknown key"),
     ("unknown nested key", lambda d: d["sensors"]["lidar"].update(rotation_rate=10), "sensors.lidar.rotation_rate", "unknown key"),
     ("unknown key in a list item", lambda d: d["ships"][0].update(colour="red"), "ships[0].colour", "unknown key"),
+    ("AIS call sign too long", lambda d: d["ships"][0]["ais"].update(call_sign="LAHB5123"), "ships[0].ais.call_sign", "at most 7"),
+    ("AIS name off the 6-bit set", lambda d: d["ships"][0]["ais"].update(name="Ødin"), "ships[0].ais.name", "6-bit"),
+    ("thesis name and its alias both given",
+     lambda d: d.setdefault("sensors", {}).setdefault("ais", {}).update(
+         noise={"AIS_SOG_measure_variance_knots2": 1.0, "sog_measure_variance_knots2": 2.0}),
+     "sensors.ais.noise.sog_measure_variance_knots2", "given twice (as AIS_SOG_measure_variance_knots2 and as sog_"),
     ("wrong type", lambda d: d.update(duration_s="long"), "duration_s", "must be a number"),
     ("NaN", lambda d: d.update(duration_s=float("nan")), "duration_s", "finite"),
     ("inf", lambda d: d["environment"].update(wind_speed_mps=float("inf")), "environment.wind_speed_mps", "finite"),
