@@ -185,7 +185,8 @@ def _versions() -> dict:
     return versions
 
 
-def render(scenario: Scenario, out_dir: Path, progress: bool | None = None, formats: tuple[str, ...] = ()) -> RenderResult:
+def render(scenario: Scenario, out_dir: Path, progress: bool | None = None, formats: tuple[str, ...] = (),
+           after_sensors: Callable[[Path], dict[str, int]] | None = None) -> RenderResult:
     """Render ``scenario`` into ``out_dir``; all or nothing.
 
     Parameters
@@ -198,6 +199,10 @@ def render(scenario: Scenario, out_dir: Path, progress: bool | None = None, form
         Show progress bars; default: when stderr is a terminal.
     formats : tuple of str
         Extra point-cloud files from the LiDAR sweeps (:data:`raysim.recording.pointclouds.FORMATS`).
+    after_sensors : callable, optional
+        Called with the staged recording directory once the sensors' files and a provisional
+        manifest are written (``raysim run`` runs the TDM here, so its targets join the bag);
+        returns counts to add to the manifest. An error in it leaves nothing on disk.
     """
     if progress is None:
         progress = sys.stderr.isatty()
@@ -227,6 +232,29 @@ def render(scenario: Scenario, out_dir: Path, progress: bool | None = None, form
             renderer(ctx)
             wall[name] = time.perf_counter() - t0
             rendered.append(name)
+        def manifest_now() -> dict:
+            return {
+                "format": "raysim-recording",
+                "format_version": 1,
+                "scenario": scenario.name,
+                "seed": scenario.seed,
+                "start_time": schema.to_plain(scenario.start_time),
+                "duration_s": scenario.duration_s,
+                "sensors_enabled": list(enabled),
+                "sensors_rendered": rendered,
+                "sensors_not_available": not_available,
+                "objects": [{"id": o.object_id, "name": o.name, "kind": o.kind} for o in world.objects],
+                "counts": dict(sorted(ctx.counts.items())),
+                "versions": _versions(),
+                "wall_time_s": {k: round(v, 3) for k, v in wall.items()},
+            }
+
+        if after_sensors is not None:
+            with atomic_path(staged.path / MANIFEST) as tmp:
+                tmp.write_text(json.dumps(manifest_now(), indent=2) + "\n", encoding="utf-8")
+            t0 = time.perf_counter()
+            ctx.counts.update(after_sensors(staged.path))
+            wall["tdm"] = time.perf_counter() - t0
         t0 = time.perf_counter()
         from raysim.recording.rosbag import write_rosbag
 
@@ -246,21 +274,7 @@ def render(scenario: Scenario, out_dir: Path, progress: bool | None = None, form
 
             ctx.counts.update(write_point_cloud_files(staged.path, tuple(formats)))
         wall["total"] = time.perf_counter() - started
-        manifest = {
-            "format": "raysim-recording",
-            "format_version": 1,
-            "scenario": scenario.name,
-            "seed": scenario.seed,
-            "start_time": schema.to_plain(scenario.start_time),
-            "duration_s": scenario.duration_s,
-            "sensors_enabled": list(enabled),
-            "sensors_rendered": rendered,
-            "sensors_not_available": not_available,
-            "objects": [{"id": o.object_id, "name": o.name, "kind": o.kind} for o in world.objects],
-            "counts": dict(sorted(ctx.counts.items())),
-            "versions": _versions(),
-            "wall_time_s": {k: round(v, 3) for k, v in wall.items()},
-        }
+        manifest = manifest_now()
         with atomic_path(staged.path / MANIFEST) as tmp:
             tmp.write_text(json.dumps(manifest, indent=2) + "\n", encoding="utf-8")
         staged.commit()

@@ -13,6 +13,7 @@ Written with rosbags (pure Python) from the recording's own files, one message a
 | /tf_static | tf2_msgs/TFMessage: base_link -> lidar, base_link -> radar | the scenario's mounts |
 | /tf | tf2_msgs/TFMessage: map -> base_link | ownship.jsonl (10 Hz) |
 | /truth/objects | visualization_msgs/MarkerArray: a box per object | truth.jsonl (1 Hz) |
+| /tdm/detected_targets | tdm_msgs/DetectedTargetArray (registered from its .msg text) | tdm/detected_targets.jsonl, one per epoch (when the TDM ran) |
 
 Stamps are the scenario's UTC start plus each message's time; the bag's own time stamp of a
 message is its header stamp.
@@ -29,7 +30,8 @@ import numpy as np
 from raysim.recording.jsonl import every, truth_epochs
 from raysim.recording.pointclouds import PCD_DTYPE, velodyne_points
 
-__all__ = ["write_rosbag", "RADAR_SECTOR_MSG", "RADAR_ECHO_MSG", "NMEA_SENTENCE_MSG", "POINT_STEP"]
+__all__ = ["write_rosbag", "RADAR_SECTOR_MSG", "RADAR_ECHO_MSG", "NMEA_SENTENCE_MSG", "DETECTED_TARGET_MSG",
+           "DETECTED_TARGET_ARRAY_MSG", "POINT_STEP"]
 
 RADAR_ECHO_MSG = "float32[] echoes\n"
 RADAR_SECTOR_MSG = """std_msgs/Header header
@@ -42,6 +44,19 @@ float32 range_max
 marine_sensor_msgs/RadarEcho[] intensities
 """
 NMEA_SENTENCE_MSG = "std_msgs/Header header\nstring sentence\n"
+#: The thesis's detected-target message (Table 6.3) plus its sources, covariance and MMSI (0 = none).
+DETECTED_TARGET_MSG = """int32 target_id
+string object_descriptor
+float64 longitude
+float64 latitude
+float64 cog_deg
+float64 sog_mps
+float64 cross_section_m2
+string[] sources
+float64[4] position_covariance_m2
+uint32 mmsi
+"""
+DETECTED_TARGET_ARRAY_MSG = "std_msgs/Header header\ntdm_msgs/DetectedTarget[] targets\n"
 POINT_STEP = PCD_DTYPE.itemsize  # velodyne_pointcloud XYZIRT: 4 x float32, uint16 ring, float32 time: 22
 
 
@@ -53,6 +68,8 @@ def _typestore():
     types.update(get_types_from_msg(RADAR_ECHO_MSG, "marine_sensor_msgs/msg/RadarEcho"))
     types.update(get_types_from_msg(RADAR_SECTOR_MSG, "marine_sensor_msgs/msg/RadarSector"))
     types.update(get_types_from_msg(NMEA_SENTENCE_MSG, "nmea_msgs/msg/Sentence"))
+    types.update(get_types_from_msg(DETECTED_TARGET_MSG, "tdm_msgs/msg/DetectedTarget"))
+    types.update(get_types_from_msg(DETECTED_TARGET_ARRAY_MSG, "tdm_msgs/msg/DetectedTargetArray"))
     store.register(types)
     return store
 
@@ -227,7 +244,35 @@ def write_rosbag(recording: Path, scenario, out: Path | None = None) -> dict:
                 markers = [_marker(store, t_ns, row) for row in rows]
                 put("/truth/objects", "visualization_msgs/msg/MarkerArray", t_ns,
                     T["visualization_msgs/msg/MarkerArray"](markers=markers))
+
+        targets = recording / "tdm" / "detected_targets.jsonl"
+        if targets.is_file():
+            Target = T["tdm_msgs/msg/DetectedTarget"]
+            for t_s, rows in _epochs(targets):
+                t_ns = ns(t_s)
+                msgs = [Target(target_id=r["target_id"], object_descriptor=r["object_descriptor"],
+                               longitude=r["longitude"], latitude=r["latitude"], cog_deg=r["cog_deg"],
+                               sog_mps=r["sog_mps"], cross_section_m2=r["cross_section_m2"], sources=r["sources"],
+                               position_covariance_m2=np.array(r["position_cov_m2"], dtype=np.float64).ravel(),
+                               mmsi=r.get("mmsi") or 0) for r in rows]
+                put("/tdm/detected_targets", "tdm_msgs/msg/DetectedTargetArray", t_ns,
+                    T["tdm_msgs/msg/DetectedTargetArray"](header=_header(store, t_ns, "map"), targets=msgs))
     return counts
+
+
+def _epochs(path: Path):
+    """(t, rows) of a JSON-lines file whose lines come in groups of equal ``t``."""
+    t_cur, rows = None, []
+    with open(path, encoding="utf-8") as handle:
+        for line in handle:
+            row = json.loads(line)
+            if rows and row["t"] != t_cur:
+                yield t_cur, rows
+                rows = []
+            t_cur = row["t"]
+            rows.append(row)
+    if rows:
+        yield t_cur, rows
 
 
 #: marker colours (r, g, b) per truth kind

@@ -1,0 +1,116 @@
+"""What the front ends hand to the trackers: one scan's detections in ENU.
+
+A scan is one LiDAR revolution or one radar sweep. Each detection is a cluster
+(LiDAR) or a plot (radar) reduced to a position with a covariance, a size and
+its own time. AIS reports are a separate type (:class:`AisReport`), keyed by MMSI.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass
+class Detections:
+    """The detections of one scan.
+
+    Attributes
+    ----------
+    sensor : str
+        ``"lidar"`` or ``"radar"``.
+    scan_time_s : float
+        The scan's reference time (its first point or spoke), s since the recording's start.
+    time_s : (N,) float64
+        Each detection's own time (mean time of its points or spokes), s.
+    position_m : (N, 2) float64
+        Centroid in ENU (east, north), metres.
+    position_cov_m2 : (N, 2, 2) float64
+        Measurement covariance of the position, m^2, from the geometry (extent, resolution).
+    cross_section_m2 : (N,) float64
+        Size measure: the visible footprint area, m^2 (the thesis's cross-section).
+    length_m, width_m : (N,) float64
+        Oriented footprint box, metres (length >= width).
+    orientation_deg : (N,) float64
+        Direction of the box's long side, compass degrees in [0, 180).
+    height_m : (N,) float64
+        Top of the cluster above the sea, metres (NaN for radar).
+    n_cells : (N,) int64
+        Points (LiDAR) or range-azimuth cells (radar) in the detection.
+    range_m : (N,) float64
+        Distance from the sensor, metres.
+    """
+
+    sensor: str
+    scan_time_s: float
+    time_s: np.ndarray
+    position_m: np.ndarray
+    position_cov_m2: np.ndarray
+    cross_section_m2: np.ndarray
+    length_m: np.ndarray
+    width_m: np.ndarray
+    orientation_deg: np.ndarray
+    height_m: np.ndarray
+    n_cells: np.ndarray
+    range_m: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.time_s.shape[0])
+
+    @classmethod
+    def empty(cls, sensor: str, scan_time_s: float) -> "Detections":
+        z = np.zeros(0)
+        return cls(sensor, float(scan_time_s), z, np.zeros((0, 2)), np.zeros((0, 2, 2)), z, z, z, z, z,
+                   np.zeros(0, dtype=np.int64), z)
+
+
+@dataclass
+class AisReport:
+    """One decoded AIS position report in ENU.
+
+    Attributes
+    ----------
+    time_s : float
+        Reception time, s since the recording's start (from the TAG block).
+    mmsi : int
+    position_m : (2,) float64
+        ENU (east, north), metres.
+    cog_deg, sog_mps : float
+        Course and speed over ground (NaN when not available).
+    heading_deg : float
+        True heading (NaN when not available, AIS 511).
+    rot_deg_per_min : float
+        Rate of turn (NaN when not available).
+    msg_type : int
+    """
+
+    time_s: float
+    mmsi: int
+    position_m: np.ndarray
+    cog_deg: float
+    sog_mps: float
+    heading_deg: float
+    rot_deg_per_min: float
+    msg_type: int
+
+
+@dataclass
+class AisStatic:
+    """Static data of one MMSI (types 5 and 24): name, ship type and dimensions in metres."""
+
+    mmsi: int
+    name: str = ""
+    ship_type: int = 0
+    length_m: float = float("nan")
+    beam_m: float = float("nan")
+
+
+@dataclass
+class ReadStats:
+    """Counted problems met while reading a recording (printed as warnings, kept in metrics)."""
+
+    warnings: dict[str, int] = field(default_factory=dict)
+
+    def count(self, what: str, n: int = 1) -> None:
+        self.warnings[what] = self.warnings.get(what, 0) + n

@@ -1,0 +1,1 @@
+"""Front ends of the TDM: raw sensor scans in, :class:`tdm.detections.Detections` out."""

@@ -1,0 +1,265 @@
+r"""AIS front end: ``ais/ais.nmea`` to position reports in ENU and static data per MMSI.
+
+Each line of the file is an ``!AIVDM`` sentence prefixed by an NMEA 4.10 TAG block
+carrying its reception time, ``\c:<unix s>*hh\!AIVDM,...*hh`` (REFERENCE.md section 4).
+Sentences are parsed with pyais (``NMEASentenceFactory``; multi-sentence messages joined
+with ``NMEAMessage.assemble_from_iterable``), so any receiver's log in that form reads.
+
+Decisions (each problem is counted in :class:`tdm.detections.ReadStats` under a key
+starting with ``"ais/nmea: "`` and the line or message is skipped):
+
+* Time: the TAG block's ``c:`` field, UNIX seconds (a value above 1e11 is taken as
+  milliseconds, as some receivers write), minus the recording's start. A line without a
+  TAG block time (or with a bad TAG block checksum) is counted and skipped: borrowing
+  the previous line's time would invent a time the receiver never gave.
+* A bad sentence checksum, an unparsable line (garbage, non-ASCII, a sentence other
+  than ``!xxVDM``/``!xxVDO``), a fragment without its partners (an orphan), a message too
+  short for the fields read, a message type that is not used here, and a position report
+  without a position (lon 181 / lat 91) are counted and skipped.
+* ``!AIVDO`` sentences (the own ship's transponder) are not targets: skipped, not counted.
+* Types 1, 2, 3 (Class A), 18 and 19 (Class B) give an :class:`AisReport`; types 5, 19
+  and 24 (parts A and B) fill an :class:`AisStatic` per MMSI (later messages update it).
+* Units: SOG knots -> m/s (1 kn = 1852/3600 m/s, REFERENCE.md section 1); SOG 102.3
+  (1023), COG 360 (3600) and heading 511 mean not available -> NaN.
+* ROT: decoded from the raw indicator bits (pyais rounds its deg/min to whole degrees):
+  ``ROT = sign(k) (k / 4.733)^2`` deg/min (ITU-R M.1371: ``k = 4.733 sqrt(ROT)``, sign
+  kept). ``-128`` (not available) -> NaN. ``+-127`` (turning faster than 5 deg per 30 s,
+  no turn indicator) -> NaN as well: the sign says which way, but there is no rate to
+  filter with, and a clamped 10 deg/min would be a made-up measurement. ``+-126`` is
+  708 deg/min or more.
+* Dimensions: length = to_bow + to_stern, beam = to_port + to_starboard, metres; a sum
+  of 0 means not available -> NaN.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+from pyais import NMEAMessage, bit_vector
+from pyais.exceptions import AISBaseException, UnknownMessageException
+from pyais.messages import NMEASentenceFactory
+
+from tdm.detections import AisReport, AisStatic, ReadStats
+from tdm.frames import EnuFrame
+
+__all__ = ["read_ais", "rot_deg_per_min", "MPS_PER_KNOT"]
+
+MPS_PER_KNOT = 1852.0 / 3600.0  # REFERENCE.md section 1
+ROT_SCALE = 4.733  # ITU-R M.1371 ROT indicator: k = 4.733 sqrt(ROT deg/min) (REFERENCE.md section 4)
+ROT_NOT_AVAILABLE = -128
+ROT_NO_INDICATOR = 127  # +-127: turning at more than 5 deg / 30 s, no turn indicator
+ROT_BIT, ROT_WIDTH = 42, 8  # types 1-3: signed 8-bit ROT indicator at bit 42 (gpsd AIVDM)
+SOG_NOT_AVAILABLE_KN = 102.3
+COG_NOT_AVAILABLE_DEG = 360.0
+HEADING_NOT_AVAILABLE = 511
+LON_NOT_AVAILABLE, LAT_NOT_AVAILABLE = 181.0, 91.0
+MILLISECOND_TIMES_ABOVE = 1e11  # a c: value above this (year 5138 in seconds) is in milliseconds
+
+POSITION_TYPES = (1, 2, 3, 18, 19)
+STATIC_TYPES = (5, 19, 24)
+#: Bits a message must hold for the fields read here: the end of its last field used (gpsd AIVDM tables).
+MIN_BITS = {1: 137, 2: 137, 3: 137, 18: 133, 19: 301, 5: 270}
+MIN_BITS_24 = {0: 160, 1: 162}  # part A: name; part B: dimensions
+PREFIX = "ais/nmea: "
+_OTHER_SENTENCE = re.compile(rb"^[$!][A-Z]{5},")  # a well-formed NMEA 0183 sentence of another kind
+
+
+def rot_deg_per_min(indicator):
+    """Rate of turn from the AIS ROT indicator (module docstring).
+
+    Parameters
+    ----------
+    indicator : int or array of int
+        Raw signed ROT field, -128..127.
+
+    Returns
+    -------
+    float or ndarray of float64
+        Rate of turn, deg/min (positive = turning right, clockwise); NaN for -128 and +-127.
+    """
+    k = np.asarray(indicator, dtype=float)
+    rot = np.sign(k) * (k / ROT_SCALE) ** 2
+    rot = np.where((k == ROT_NOT_AVAILABLE) | (np.abs(k) == ROT_NO_INDICATOR) | (np.abs(k) > 128), np.nan, rot)
+    return float(rot) if rot.ndim == 0 else rot
+
+
+def _tag_time_s(sentence) -> float | None:
+    """UNIX time of a sentence's TAG block, s (None: no TAG block, bad checksum or no ``c:``)."""
+    tb = sentence.tag_block
+    if tb is None:
+        return None
+    tb.init()
+    if not tb.is_valid or tb.receiver_timestamp is None:
+        return None
+    try:
+        value = float(tb.receiver_timestamp)
+    except ValueError:
+        return None
+    if not math.isfinite(value):
+        return None
+    return value / 1000.0 if value > MILLISECOND_TIMES_ABOVE else value
+
+
+def _payload_bits(sentence) -> int:
+    return 6 * len(sentence.payload) - int(sentence.fill_bits)
+
+
+def _dimension(a, b) -> float:
+    total = (a or 0) + (b or 0)
+    return float(total) if total > 0 else float("nan")
+
+
+def _text(value) -> str:
+    return str(value or "").replace("@", " ").strip()
+
+
+def _not_available(value, code: float) -> float:
+    return float("nan") if value is None or float(value) >= code else float(value)
+
+
+def read_ais(path: Path, frame: EnuFrame, start_time_unix_s: float,
+             stats: ReadStats) -> tuple[list[AisReport], dict[int, AisStatic]]:
+    """Position reports and static data of an AIS NMEA log.
+
+    Parameters
+    ----------
+    path : Path
+        ``ais/ais.nmea``: one TAG-blocked ``!AIVDM`` sentence per line.
+    frame : EnuFrame
+        The TDM's local frame; positions are mapped with ``frame.to_enu``.
+    start_time_unix_s : float
+        UNIX time of the recording's start (manifest.json ``start_time``), s.
+    stats : ReadStats
+        Receives a count for every line or message skipped (module docstring).
+
+    Returns
+    -------
+    reports : list of AisReport
+        Types 1/2/3/18/19, sorted by time (stable: file order within a second). ``time_s``
+        is the TAG block time minus the start, s (1 s resolution when the receiver writes whole
+        seconds); ``position_m`` (2,) ENU metres; ``sog_mps`` m/s; ``cog_deg``, ``heading_deg``
+        compass degrees; ``rot_deg_per_min`` (NaN for Class B).
+    static : dict of int to AisStatic
+        Name, ship type, length and beam (m) per MMSI, from types 5, 19 and 24.
+
+    Notes
+    -----
+    A missing file returns ``([], {})``: AIS may be absent from a recording, and the caller
+    decides whether that matters.
+    """
+    path = Path(path)
+    try:
+        raw = path.read_bytes()
+    except FileNotFoundError:
+        return [], {}
+
+    rows: list[tuple[float, int, int, float, float, float, float, float, float]] = []
+    static: dict[int, AisStatic] = {}
+    pending: dict[tuple, list] = {}  # (fragment count, sequence id, channel) -> [(sentence, time), ...]
+
+    def handle(sentence, time_unix_s: float) -> None:
+        try:
+            msg = sentence.decode()
+        except AISBaseException:
+            stats.count(PREFIX + f"message type {sentence.ais_id} skipped (not used)")
+            return
+        except (ValueError, IndexError, TypeError, KeyError):
+            stats.count(PREFIX + "undecodable message skipped")
+            return
+        kind = int(msg.msg_type)
+        bits = _payload_bits(sentence)
+        if kind == 24:
+            need = MIN_BITS_24.get(int(msg.partno or 0), 168)
+        elif kind in MIN_BITS:
+            need = MIN_BITS[kind]
+        else:
+            stats.count(PREFIX + f"message type {kind} skipped (not used)")
+            return
+        if bits < need:
+            stats.count(PREFIX + "message too short for its type skipped")
+            return
+        mmsi = int(msg.mmsi)
+        if kind in STATIC_TYPES:
+            entry = static.setdefault(mmsi, AisStatic(mmsi))
+            if kind in (5, 19) or (kind == 24 and msg.partno == 0):
+                entry.name = _text(msg.shipname)
+            if kind in (5, 19) or (kind == 24 and msg.partno == 1):
+                entry.ship_type = int(msg.ship_type or 0)
+                if hasattr(msg, "to_bow"):  # a type 24 B of an auxiliary craft has a mothership instead
+                    entry.length_m = _dimension(msg.to_bow, msg.to_stern)
+                    entry.beam_m = _dimension(msg.to_port, msg.to_starboard)
+        if kind not in POSITION_TYPES:
+            return
+        lon, lat = msg.lon, msg.lat
+        if lon is None or lat is None or abs(lon) >= LON_NOT_AVAILABLE or abs(lat) >= LAT_NOT_AVAILABLE \
+                or abs(lat) > 90.0 or abs(lon) > 180.0:
+            stats.count(PREFIX + "position report without a position (lon 181 / lat 91) skipped")
+            return
+        sog = _not_available(msg.speed, SOG_NOT_AVAILABLE_KN) * MPS_PER_KNOT
+        cog = _not_available(msg.course, COG_NOT_AVAILABLE_DEG)
+        heading = float("nan") if msg.heading is None or msg.heading >= 360 else float(msg.heading)
+        rot = float("nan")
+        if kind in (1, 2, 3):
+            rot = rot_deg_per_min(bit_vector(sentence.payload, sentence.fill_bits).get_num(ROT_BIT, ROT_WIDTH, True))
+        rows.append((time_unix_s - float(start_time_unix_s), mmsi, kind, float(lat), float(lon), cog, sog, heading,
+                     rot))
+
+    for line in raw.splitlines():
+        line = line.strip()
+        if not line:
+            continue
+        try:
+            sentence = NMEASentenceFactory.produce(line)
+        except UnknownMessageException:
+            other = _OTHER_SENTENCE.match(line.rsplit(b"\\", 1)[-1])
+            stats.count(PREFIX + ("sentence other than !AIVDM skipped" if other else "unparsable line skipped"))
+            continue
+        except (AISBaseException, ValueError, IndexError, TypeError, UnicodeError):
+            stats.count(PREFIX + "unparsable line skipped")
+            continue
+        if getattr(sentence, "TYPE", None) != NMEAMessage.TYPE:
+            stats.count(PREFIX + "sentence other than !AIVDM skipped")
+            continue
+        if not sentence.is_valid:
+            stats.count(PREFIX + "bad checksum skipped")
+            continue
+        t_unix = _tag_time_s(sentence)
+        if t_unix is None:
+            stats.count(PREFIX + "line without a (valid) TAG block time skipped")
+            continue
+        if sentence.type == "VDO":
+            continue
+        if sentence.frag_cnt == 1:
+            handle(sentence, t_unix)
+            continue
+        key = (sentence.frag_cnt, sentence.seq_id, sentence.channel)
+        group = pending.get(key)
+        if sentence.frag_num == 1:
+            if group:
+                stats.count(PREFIX + "orphan fragment skipped", len(group))
+            pending[key] = [(sentence, t_unix)]
+            continue
+        if not group or group[-1][0].frag_num != sentence.frag_num - 1:
+            stats.count(PREFIX + "orphan fragment skipped", 1 + len(group or []))
+            pending.pop(key, None)
+            continue
+        group.append((sentence, t_unix))
+        if len(group) == sentence.frag_cnt:
+            del pending[key]
+            handle(NMEAMessage.assemble_from_iterable([s for s, _ in group]), group[0][1])
+    for group in pending.values():
+        stats.count(PREFIX + "orphan fragment skipped", len(group))
+
+    if not rows:
+        return [], static
+    rows.sort(key=lambda r: r[0])
+    lat = np.array([r[3] for r in rows])
+    lon = np.array([r[4] for r in rows])
+    east, north = frame.to_enu(lat, lon)
+    reports = [AisReport(time_s=r[0], mmsi=r[1], position_m=np.array([e, n]), cog_deg=r[5], sog_mps=r[6],
+                         heading_deg=r[7], rot_deg_per_min=r[8], msg_type=r[2])
+               for r, e, n in zip(rows, east, north)]
+    return reports, static

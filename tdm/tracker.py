@@ -1,0 +1,347 @@
+"""Per-sensor multi-target trackers: one EKF per sensor per target (REFERENCE.md section 5).
+
+Roles, in Stone Soup's terms:
+
+- predictor / updater: :mod:`tdm.ekf` (thesis model, Joseph-form update);
+- hypothesiser / associator: :mod:`tdm.association` (Mahalanobis gate, GNN);
+- initiator: an unassociated detection starts a tentative track; its second detection sets
+  course and speed from the two positions (two-point initialisation);
+- confirmation: M of the last N scans that could see the track;
+- deleter: a track not updated for ``coast_s`` seconds, or a tentative track that can no
+  longer reach M of N, is removed; two confirmed tracks of one sensor closer than the
+  merge gate are one object seen twice and the younger is removed.
+
+:class:`PositionTracker` tracks LiDAR clusters and radar plots; :class:`AisTracker` keeps
+one track per MMSI, created by the first report.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections import deque
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from tdm import ekf
+from tdm.association import chi2_gate, gnn, mahalanobis2
+from tdm.detections import AisReport, AisStatic, Detections
+
+
+@dataclass(frozen=True)
+class TrackerConfig:
+    """Parameters of one sensor's tracker (engineering defaults, unverified).
+
+    Attributes
+    ----------
+    gate_probability : float
+        Probability mass inside the association gate (chi-square, 2 dof).
+    confirm_m, confirm_n : int
+        Confirm a track with M hits in the last N scans that could see it.
+    coast_s : float
+        Delete a track not updated for this long, s.
+    position_floor_m2 : float
+        Smallest measurement variance per axis, m^2 (covers centroid jitter as the aspect changes).
+    cross_section_sigma_m2 : float
+        Measurement noise of the cross-section, m^2.
+    max_range_m : float
+        Tracks predicted beyond this range from the own ship are out of view: no misses counted.
+    init_speed_sigma_mps : float
+        Speed uncertainty of a new tentative track, m/s.
+    merge_distance_m : float
+        Two confirmed tracks of this sensor closer than this, or than half their summed lengths,
+        and moving alike (speeds within ``merge_speed_mps``) are one object.
+    merge_speed_mps : float
+    strong_cells : int or None
+        A detection of at least this many cells (a large object: sea clutter rarely makes one)
+        counts 1.5 hits towards confirmation, so two strong detections in a row confirm a radar
+        track with M = 3. None: every hit counts 1.
+    max_speed_mps : float
+        A track faster than this (20 m/s = 39 kn: faster than the ships this TDM is for) is
+        deleted: it is clutter joined across scans.
+    process : ekf.ProcessNoise
+    """
+
+    gate_probability: float = 0.999
+    confirm_m: int = 3
+    confirm_n: int = 5
+    coast_s: float = 3.0
+    position_floor_m2: float = 1.0
+    cross_section_sigma_m2: float = 50.0
+    max_range_m: float = 100.0
+    init_speed_sigma_mps: float = 8.0
+    merge_distance_m: float = 10.0
+    merge_speed_mps: float = 3.0
+    strong_cells: int | None = None
+    max_speed_mps: float = 20.0
+    process: ekf.ProcessNoise = field(default_factory=ekf.ProcessNoise)
+
+
+@dataclass
+class Track:
+    """One sensor's track of one object.
+
+    Attributes
+    ----------
+    track_id : int
+        Unique within the sensor.
+    sensor : str
+    x : (6,) float
+        State at ``t_s`` (:mod:`tdm.ekf`).
+    p : (6, 6) float
+    t_s : float
+        Time of the state, s.
+    created_s, updated_s : float
+        Times of the first and of the last update, s.
+    confirmed : bool
+    hits : deque of bool
+        Hit (True) or miss for the last N scans that could see the track.
+    n_updates : int
+    mmsi : int or None
+        AIS tracks only.
+    """
+
+    track_id: int
+    sensor: str
+    x: np.ndarray
+    p: np.ndarray
+    t_s: float
+    created_s: float
+    updated_s: float
+    confirmed: bool = False
+    hits: deque = field(default_factory=deque)
+    n_updates: int = 1
+    mmsi: int | None = None
+    first_position_m: np.ndarray | None = None
+    first_cov_m2: np.ndarray | None = None
+    height_m: float = float("nan")
+    length_m: float = 0.0
+    process: ekf.ProcessNoise = field(default_factory=ekf.ProcessNoise)
+
+    def predicted(self, t_s: float) -> tuple[np.ndarray, np.ndarray]:
+        """State (6,) and covariance (6, 6) predicted to ``t_s`` (the track is not changed)."""
+        return ekf.predict(self.x, self.p, t_s - self.t_s, self.process)
+
+
+class PositionTracker:
+    """GNN + EKF tracker of one position sensor (``"lidar"`` or ``"radar"``)."""
+
+    def __init__(self, sensor: str, config: TrackerConfig):
+        self.sensor = sensor
+        self.config = config
+        self.tracks: list[Track] = []
+        self._ids = itertools.count(1)
+        self._gate = chi2_gate(config.gate_probability, 2)
+
+    # ---- public -------------------------------------------------------------------------
+    def process(self, dets: Detections, ownship_position_m: np.ndarray) -> None:
+        """Associate one scan's detections, update, initiate, confirm and delete.
+
+        Parameters
+        ----------
+        dets : Detections
+            The scan.
+        ownship_position_m : (2,) float
+            Own-ship position (east, north) at the scan, m (for the field of view).
+        """
+        cfg = self.config
+        n_det = len(dets)
+        pos = dets.position_m
+        cov = dets.position_cov_m2 + np.eye(2) * cfg.position_floor_m2
+        t_scan = float(np.mean(dets.time_s)) if n_det else dets.scan_time_s
+        tracks = self.tracks
+        pairs: list[tuple[int, int]] = []
+        if tracks and n_det:
+            states = np.stack([t.x for t in tracks])
+            # mean predicted to each detection's own time; covariance at the scan's mean time
+            dt = dets.time_s[None, :] - np.array([t.t_s for t in tracks])[:, None]
+            pred = ekf.predict_mean(states[:, None, :], dt)
+            p_pos = np.stack([t.predicted(t_scan)[1][:2, :2] for t in tracks])
+            s = p_pos[:, None] + cov[None, :]
+            cost = mahalanobis2(pos[None, :, :] - pred[..., :2], s)
+            pairs = gnn(cost, self._gate)
+        assigned_tracks = {i for i, _ in pairs}
+        assigned_dets = {j for _, j in pairs}
+        for i, j in pairs:
+            self._update(tracks[i], dets, j, cov[j])
+        # misses for tracks that could see their object
+        for i, track in enumerate(tracks):
+            if i in assigned_tracks:
+                continue
+            x_pred = ekf.predict_mean(track.x, t_scan - track.t_s)
+            if np.hypot(*(x_pred[:2] - ownship_position_m)) <= cfg.max_range_m:
+                self._record(track, 0.0)
+        for j in range(n_det):
+            if j not in assigned_dets:
+                self._initiate(dets, j, cov[j])
+        self._delete(t_scan)
+
+    def confirmed_tracks(self) -> list[Track]:
+        return [t for t in self.tracks if t.confirmed]
+
+    # ---- roles --------------------------------------------------------------------------
+    def _record(self, track: Track, hit: float) -> None:
+        track.hits.append(float(hit))
+        while len(track.hits) > self.config.confirm_n:
+            track.hits.popleft()
+        if not track.confirmed and sum(track.hits) >= self.config.confirm_m:
+            track.confirmed = True
+
+    def _measurement(self, dets: Detections, j: int, cov_j: np.ndarray):
+        z = np.array([dets.position_m[j, 0], dets.position_m[j, 1], dets.cross_section_m2[j]])
+        r = np.zeros((3, 3))
+        r[:2, :2] = cov_j
+        r[2, 2] = self.config.cross_section_sigma_m2 ** 2
+        return z, r
+
+    def _update(self, track: Track, dets: Detections, j: int, cov_j: np.ndarray) -> None:
+        t = float(dets.time_s[j])
+        if track.n_updates == 1 and t - track.t_s > 1e-3:
+            self._two_point(track, dets.position_m[j], cov_j, t)
+        x, p = track.predicted(t)
+        z, r = self._measurement(dets, j, cov_j)
+        track.x, track.p, _ = ekf.update(x, p, z, ekf.H_POSITION_SIZE, r)
+        track.t_s = track.updated_s = t
+        track.n_updates += 1
+        strong = self.config.strong_cells is not None and dets.n_cells[j] >= self.config.strong_cells
+        track.length_m = 0.8 * track.length_m + 0.2 * float(dets.length_m[j]) if track.n_updates > 2 else \
+            max(track.length_m, float(dets.length_m[j]))
+        if np.isfinite(dets.height_m[j]):
+            track.height_m = float(dets.height_m[j]) if not np.isfinite(track.height_m) else \
+                0.9 * track.height_m + 0.1 * float(dets.height_m[j])
+        self._record(track, 1.5 if strong else 1.0)
+
+    def _two_point(self, track: Track, position_m: np.ndarray, cov_m2: np.ndarray, t_s: float) -> None:
+        """Course and speed of a one-hit track from its first and this detection."""
+        dt = t_s - track.t_s
+        v = (position_m - track.first_position_m) / dt
+        cov_v = (cov_m2 + track.first_cov_m2) / dt**2
+        speed = float(np.hypot(*v))
+        sigma_speed = float(np.sqrt(np.trace(cov_v) / 2.0))
+        x, p = track.x.copy(), track.p.copy()
+        if speed > 2.0 * sigma_speed:
+            ve, vn = v
+            jac = np.array([[vn / speed**2, -ve / speed**2], [ve / speed, vn / speed]])
+            polar = jac @ cov_v @ jac.T
+            x[ekf.PSI], x[ekf.U] = np.arctan2(ve, vn), speed
+            p[np.ix_([ekf.PSI, ekf.U], [ekf.PSI, ekf.U])] = polar
+        else:
+            # too slow to tell the course yet: keep it unknown, bound the speed
+            p[ekf.U, ekf.U] = min(p[ekf.U, ekf.U], sigma_speed**2 + 0.25)
+        track.x, track.p = x, p
+
+    def _initiate(self, dets: Detections, j: int, cov_j: np.ndarray) -> None:
+        cfg = self.config
+        x = np.array([dets.position_m[j, 0], dets.position_m[j, 1], 0.0, 0.0, 0.0, dets.cross_section_m2[j]])
+        p = np.diag([1.0, 1.0, np.pi**2, cfg.init_speed_sigma_mps**2, np.radians(3.0)**2,
+                     cfg.cross_section_sigma_m2**2])
+        p[:2, :2] = cov_j
+        t = float(dets.time_s[j])
+        track = Track(next(self._ids), self.sensor, x, p, t, t, t,
+                      first_position_m=dets.position_m[j].copy(), first_cov_m2=cov_j.copy(),
+                      height_m=float(dets.height_m[j]), length_m=float(dets.length_m[j]), process=cfg.process)
+        strong = cfg.strong_cells is not None and dets.n_cells[j] >= cfg.strong_cells
+        self._record(track, 1.5 if strong else 1.0)
+        self.tracks.append(track)
+
+    def _delete(self, t_s: float) -> None:
+        cfg = self.config
+        keep = []
+        for track in self.tracks:
+            if t_s - track.updated_s > cfg.coast_s or abs(track.x[ekf.U]) > cfg.max_speed_mps:
+                continue
+            if not track.confirmed:
+                remaining = cfg.confirm_n - len(track.hits)
+                if sum(track.hits) + 1.5 * remaining < cfg.confirm_m:
+                    continue
+            keep.append(track)
+        # one object seen twice: keep the older confirmed track
+        confirmed = sorted((t for t in keep if t.confirmed), key=lambda t: t.created_s)
+        dropped: set[int] = set()
+        for a, b in itertools.combinations(confirmed, 2):
+            if a.track_id in dropped or b.track_id in dropped:
+                continue
+            xb = ekf.predict_mean(b.x, a.t_s - b.t_s)
+            near = max(cfg.merge_distance_m, 0.5 * (a.length_m + b.length_m))
+            va = a.x[ekf.U] * np.array([np.sin(a.x[ekf.PSI]), np.cos(a.x[ekf.PSI])])
+            vb = b.x[ekf.U] * np.array([np.sin(b.x[ekf.PSI]), np.cos(b.x[ekf.PSI])])
+            if np.hypot(*(a.x[:2] - xb[:2])) < near and np.hypot(*(va - vb)) < cfg.merge_speed_mps:
+                dropped.add(b.track_id)
+        self.tracks = [t for t in keep if t.track_id not in dropped]
+
+
+@dataclass(frozen=True)
+class AisTrackerConfig:
+    """AIS tracking parameters.
+
+    The measurement noise is the thesis's AIS noise model (REFERENCE.md section 4 / the
+    thesis's ``AIS_*`` parameters): position variance 5 + 0.5 m^2 (white + bias), COG 1 + 0.5
+    deg^2, SOG 0.5 + 0.1 kn^2, ROT 2000 + 500 (deg/min)^2. These are what the TDM assumes of any
+    transponder; they are not read from the recording.
+    """
+
+    position_var_m2: float = 5.5
+    cog_var_deg2: float = 1.5
+    sog_var_kn2: float = 0.6
+    rot_var_deg2_per_min2: float = 2500.0
+    coast_s: float = 200.0
+    process: ekf.ProcessNoise = field(default_factory=ekf.ProcessNoise)
+
+
+KNOT_MPS = 1852.0 / 3600.0
+
+
+class AisTracker:
+    """One EKF per MMSI, updated with position, COG, SOG and ROT of each report."""
+
+    def __init__(self, config: AisTrackerConfig):
+        self.config = config
+        self.tracks: dict[int, Track] = {}
+        self.static: dict[int, AisStatic] = {}
+        self._ids = itertools.count(1)
+
+    def confirmed_tracks(self) -> list[Track]:
+        return list(self.tracks.values())
+
+    def process(self, report: AisReport) -> None:
+        """Update (or start) the track of the report's MMSI."""
+        cfg = self.config
+        rows, z, var = [ekf.E, ekf.N], [report.position_m[0], report.position_m[1]], [cfg.position_var_m2] * 2
+        angle_rows: tuple[int, ...] = ()
+        moving = np.isfinite(report.sog_mps) and report.sog_mps > 0.3
+        if np.isfinite(report.cog_deg) and moving:
+            angle_rows = (len(rows),)
+            rows.append(ekf.PSI)
+            z.append(np.radians(report.cog_deg))
+            var.append(np.radians(1.0) ** 2 * cfg.cog_var_deg2)
+        if np.isfinite(report.sog_mps):
+            rows.append(ekf.U)
+            z.append(report.sog_mps)
+            var.append(cfg.sog_var_kn2 * KNOT_MPS**2)
+        if np.isfinite(report.rot_deg_per_min):
+            rows.append(ekf.R)
+            z.append(np.radians(report.rot_deg_per_min) / 60.0)
+            var.append(cfg.rot_var_deg2_per_min2 * (np.radians(1.0) / 60.0) ** 2)
+        t = float(report.time_s)
+        track = self.tracks.get(report.mmsi)
+        if track is None or t - track.updated_s > cfg.coast_s:
+            x = np.zeros(ekf.N_STATES)
+            p = np.diag([100.0, 100.0, np.pi**2, 25.0, np.radians(3.0) ** 2, 1e6])
+            track = Track(next(self._ids), "ais", x, p, t, t, t, confirmed=True, n_updates=0,
+                          mmsi=report.mmsi, process=cfg.process)
+            static = self.static.get(report.mmsi)
+            if static is not None and np.isfinite(static.length_m * static.beam_m):
+                track.x[ekf.ALPHA] = static.length_m * static.beam_m
+            self.tracks[report.mmsi] = track
+        x, p = track.predicted(t)
+        h = ekf.h_rows(*rows)
+        track.x, track.p, _ = ekf.update(x, p, np.array(z, dtype=float), h, np.diag(var), angle_rows)
+        track.t_s = track.updated_s = t
+        track.n_updates += 1
+
+    def set_static(self, static: dict[int, AisStatic]) -> None:
+        self.static.update(static)
+
+    def expire(self, t_s: float) -> None:
+        """Drop tracks whose last report is older than ``coast_s``."""
+        self.tracks = {m: tr for m, tr in self.tracks.items() if t_s - tr.updated_s <= self.config.coast_s}

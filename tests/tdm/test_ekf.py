@@ -1,0 +1,86 @@
+"""The thesis's model as an EKF, against analytic cases."""
+
+import numpy as np
+import pytest
+
+from tdm import ekf
+
+
+def test_straight_line_motion_matches_course_and_speed():
+    x = np.array([0.0, 0.0, np.radians(90.0), 5.0, 0.0, 10.0])  # due east at 5 m/s
+    out = ekf.predict_mean(x, 10.0)
+    assert out[ekf.E] == pytest.approx(50.0)
+    assert out[ekf.N] == pytest.approx(0.0, abs=1e-9)
+
+
+def test_constant_turn_stays_on_its_circle():
+    r = np.radians(3.0)  # rad/s
+    u = 5.0
+    x = np.array([0.0, 0.0, 0.0, u, r, 0.0])
+    radius = u / r
+    for _ in range(600):  # 60 s in 0.1 s steps: 180 deg of turn
+        x, _ = ekf.transition(x, 0.1)
+    centre = np.array([radius, 0.0])  # turning to starboard from north: centre to the east
+    assert np.hypot(*(x[:2] - centre)) == pytest.approx(radius, rel=1e-3)
+    assert np.degrees(ekf.wrap_pi(x[ekf.PSI])) == pytest.approx(-180.0, abs=1e-6) or \
+        np.degrees(x[ekf.PSI]) == pytest.approx(180.0, abs=1e-6)
+
+
+def test_jacobian_matches_finite_differences():
+    x = np.array([3.0, -2.0, 0.7, 4.0, 0.02, 30.0])
+    _, f = ekf.transition(x, 2.0)
+    num = np.zeros((6, 6))
+    for j in range(6):
+        dx = np.zeros(6)
+        dx[j] = 1e-6
+        num[:, j] = (ekf.transition(x + dx, 2.0)[0] - ekf.transition(x - dx, 2.0)[0]) / 2e-6
+    np.testing.assert_allclose(f, num, atol=1e-6)
+
+
+def test_joseph_update_equals_the_optimal_gain_form():
+    rng = np.random.default_rng(1)
+    a = rng.normal(size=(6, 6))
+    p = a @ a.T + np.eye(6)
+    x = rng.normal(size=6)
+    h = ekf.H_POSITION_SIZE
+    r = np.diag([2.0, 3.0, 5.0])
+    z = rng.normal(size=3)
+    x1, p1, nis = ekf.update(x, p, z, h, r)
+    s = h @ p @ h.T + r
+    k = p @ h.T @ np.linalg.inv(s)
+    np.testing.assert_allclose(p1, (np.eye(6) - k @ h) @ p, atol=1e-9)
+    assert nis == pytest.approx(float((z - h @ x) @ np.linalg.solve(s, z - h @ x)))
+
+
+def test_angle_residual_is_wrapped():
+    x = np.array([0.0, 0.0, np.radians(179.0), 5.0, 0.0, 0.0])
+    p = np.diag([1.0, 1.0, 0.1, 1.0, 1e-4, 1.0])
+    h = ekf.h_rows(ekf.PSI)
+    x1, _, _ = ekf.update(x, p, np.array([np.radians(-179.0)]), h, np.array([[1e-4]]), angle_rows=(0,))
+    # the measurement is 2 deg away across the wrap, not 358 deg
+    assert abs(np.degrees(ekf.wrap_pi(x1[ekf.PSI] - np.radians(-179.5)))) < 1.0
+
+
+def test_filter_is_consistent_on_its_own_model():
+    """NEES of position-only tracking of a simulated model target averages the state dimension."""
+    rng = np.random.default_rng(7)
+    q = ekf.ProcessNoise(position_m2_per_s=0.0, course_rad2_per_s=0.0, speed_m2_per_s3=0.01,
+                         turn_rate_rad2_per_s3=1e-7, cross_section_m4_per_s=0.1)
+    dt, n = 1.0, 300
+    nees = []
+    for run in range(20):
+        truth = np.array([0.0, 0.0, 0.3, 5.0, 0.0, 100.0])
+        x = truth + rng.normal(size=6) * [3, 3, 0.05, 0.3, 0.001, 5]
+        p = np.diag([9.0, 9.0, 0.05**2, 0.09, 1e-6, 25.0])
+        r = np.diag([4.0, 4.0, 4.0])
+        for k in range(n):
+            truth, _ = ekf.transition(truth, dt)
+            truth[ekf.U] += rng.normal() * np.sqrt(q.speed_m2_per_s3 * dt)
+            truth[ekf.R] += rng.normal() * np.sqrt(q.turn_rate_rad2_per_s3 * dt)
+            x, p = ekf.predict(x, p, dt, q)
+            z = ekf.H_POSITION_SIZE @ truth + rng.normal(size=3) * 2.0
+            x, p, _ = ekf.update(x, p, z, ekf.H_POSITION_SIZE, r)
+            if k > 50:
+                e = x[:2] - truth[:2]
+                nees.append(e @ np.linalg.solve(p[:2, :2], e))
+    assert 1.6 < np.mean(nees) < 2.6  # ideal 2 (2-D position)

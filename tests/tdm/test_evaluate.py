@@ -1,0 +1,320 @@
+"""tdm.evaluate and tdm.plots on synthetic recordings with known offsets, and on a rendered one."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import shutil
+
+import numpy as np
+import pytest
+import yaml
+
+from tdm.errors import RecordingError
+from tdm.evaluate import evaluate, format_table, write_metrics
+from tdm.frames import EnuFrame
+from tdm.plots import plot_errors, plot_tracks
+
+LAT0, LON0 = 59.43, 10.47
+DURATION_S = 20.0
+C = 50.0
+CONTRACT_KEYS = {"ospa_m", "gospa_m", "position_rmse_m", "cog_rmse_deg", "sog_rmse_mps", "detection_rate",
+                 "false_targets_per_min", "id_switches", "nees", "per_sensor"}
+
+
+def _objects(t):
+    """Truth at time t: (id, name, kind, east, north, cog, sog, ais). The own ship moves north at 2 m/s."""
+    return [
+        (0, "odin", "ownship", 0.0, 2.0 * t, 0.0, 2.0, False),
+        (1, "alpha", "ship", 100.0, 5.0 * t, 0.0, 5.0, True),            # moving north, AIS
+        (2, "bravo", "iceberg", 0.0, 300.0, 0.0, 0.0, False),
+        (3, "charlie", "ship", -400.0, 0.0, 0.0, 0.0, False),            # silent ship, found late
+        (4, "delta", "iceberg", 5000.0, 0.0, 0.0, 0.0, False),           # out of every range
+        (5, "echo", "ship", 0.0, -3000.0, 0.0, 0.0, True),               # beyond radar, within AIS range
+    ]
+
+
+def _line(frame, t, east, north, **fields):
+    lat, lon = frame.to_geodetic(east, north)
+    return json.dumps({"t": t, "longitude": float(lon), "latitude": float(lat), **fields})
+
+
+def _target_lines(frame):
+    """Targets at truth + 3 m east every second: an id switch (bravo), a late target (charlie),
+    a false target (99) and a covariance that makes charlie's NEES 9."""
+    lines = []
+    cov_a = [[4.0, 0.0], [0.0, 9.0]]  # e = (3, 0): NEES 9/4
+    for t in np.arange(0.0, DURATION_S + 0.5, 1.0):
+        t = float(t)
+        truth = {o[1]: o for o in _objects(t)}
+        common = {"cross_section_m2": 10.0, "sources": ["radar"]}
+        a = truth["alpha"]
+        lines.append(_line(frame, t, a[3] + 3, a[4], target_id=1, object_descriptor="vessel", cog_deg=358.0,
+                           sog_mps=5.5, position_cov_m2=cov_a, **common))
+        b = truth["bravo"]
+        lines.append(_line(frame, t, b[3] + 3, b[4], target_id=2 if t < 10 else 7, object_descriptor="iceberg",
+                           cog_deg=0.0, sog_mps=0.0, position_cov_m2=cov_a, **common))
+        if t >= 5:
+            ch = truth["charlie"]
+            lines.append(_line(frame, t, ch[3] + 3, ch[4], target_id=3, object_descriptor="unknown", cog_deg=None,
+                               sog_mps=0.0, position_cov_m2=[[1.0, 0.0], [0.0, 1.0]], **common))
+        e = truth["echo"]
+        lines.append(_line(frame, t, e[3] + 3, e[4], target_id=5, object_descriptor="vessel", cog_deg=0.0,
+                           sog_mps=0.0, position_cov_m2=cov_a, **common))
+        lines.append(_line(frame, t, 0.0, -500.0, target_id=99, object_descriptor="unknown", cog_deg=0.0,
+                           sog_mps=0.0, position_cov_m2=cov_a, **common))
+    return lines
+
+
+def _track_lines(frame):
+    """Per-sensor tracks: AIS exactly on alpha and echo, radar on bravo + 1 m east."""
+    lines = []
+    for t in np.arange(0.0, DURATION_S + 0.5, 1.0):
+        t = float(t)
+        truth = {o[1]: o for o in _objects(t)}
+        for name, tid in (("alpha", 1), ("echo", 5)):
+            o = truth[name]
+            lines.append(_line(frame, t, o[3], o[4], sensor="ais", target_id=tid, object_descriptor="vessel",
+                               cog_deg=o[5], sog_mps=o[6], position_cov_m2=[[4.0, 0.0], [0.0, 4.0]]))
+        o = truth["bravo"]
+        lines.append(_line(frame, t, o[3] + 1, o[4], sensor="radar", target_id=11, object_descriptor="iceberg",
+                           cog_deg=0.0, sog_mps=0.0, position_cov_m2=[[1.0, 0.0], [0.0, 1.0]]))
+    return lines
+
+
+def make_recording(root, sensors=("radar", "ais", "nav"), targets=True, tracks=True):
+    """A recording directory with truth, scenario, manifest and the TDM's outputs (no LiDAR sweeps).
+
+    ``targets``: True for :func:`_target_lines`, False for none, or a function of the frame giving lines.
+    """
+    frame = EnuFrame(LAT0, LON0)
+    root.mkdir(parents=True)
+    with open(root / "truth.jsonl", "w", encoding="utf-8") as f:
+        for t in np.round(np.arange(0.0, DURATION_S + 0.05, 0.1), 1):
+            for oid, name, kind, east, north, cog, sog, ais in _objects(float(t)):
+                lat, lon = frame.to_geodetic(east, north)
+                f.write(json.dumps({"t": float(t), "id": oid, "name": name, "kind": kind, "lat": float(lat),
+                                    "lon": float(lon), "x": east, "y": north, "heading_deg": cog, "cog_deg": cog,
+                                    "sog_mps": sog, "length_m": 20.0, "beam_m": 5.0, "height_m": 5.0, "ais": ais,
+                                    "mmsi": 257000000 + oid if ais else None}) + "\n")
+    scenario = {"name": "synthetic", "duration_s": DURATION_S, "tdm": {"update_rate_hz": 1.0},
+                "sensors": {"lidar": {"enabled": True, "range_max_m": 200.0},
+                            "radar": {"enabled": True, "range_m": 1000.0},
+                            "ais": {"enabled": True, "range_m": 10000.0}}}
+    (root / "scenario.yaml").write_text(yaml.safe_dump(scenario), encoding="utf-8")
+    (root / "manifest.json").write_text(json.dumps({"duration_s": DURATION_S, "sensors_rendered": list(sensors)}),
+                                        encoding="utf-8")
+    (root / "tdm").mkdir()
+    if targets:
+        lines = (_target_lines if targets is True else targets)(frame)
+        (root / "tdm" / "detected_targets.jsonl").write_text("".join(x + "\n" for x in lines), encoding="utf-8")
+    if tracks:
+        (root / "tdm" / "sensor_tracks.jsonl").write_text("\n".join(_track_lines(frame)) + "\n", encoding="utf-8")
+    return root
+
+
+@pytest.fixture(scope="module")
+def synthetic(tmp_path_factory):
+    rec = make_recording(tmp_path_factory.mktemp("synthetic") / "rec")
+    return rec, evaluate(rec)
+
+
+def test_known_offsets_give_known_errors(synthetic):
+    _, m = synthetic
+    assert CONTRACT_KEYS <= set(m)
+    assert m["epochs"] == 21
+    assert m["position_rmse_m"] == pytest.approx(3.0, abs=1e-4)
+    assert m["median_position_error_m"] == pytest.approx(3.0, abs=1e-4)
+    assert m["median_position_error_within_lidar_range_m"] == pytest.approx(3.0, abs=1e-4)
+    assert m["median_position_error_beyond_lidar_range_m"] == pytest.approx(3.0, abs=1e-4)
+    assert m["position_bias_east_m"] == pytest.approx(3.0, abs=1e-4)
+    assert m["cog_rmse_deg"] == pytest.approx(2.0, abs=1e-6)  # 358 vs 0, wrapped; alpha only: the others do not move
+    assert m["sog_rmse_mps"] == pytest.approx(math.sqrt(21 * 0.25 / 79), rel=1e-5)
+    # NEES: 63 pairs at 9/4, charlie's 16 at 9 (outside the 95 % interval [0.05, 7.38])
+    assert m["nees"] == pytest.approx((63 * 2.25 + 16 * 9) / 79, rel=1e-4)
+    assert m["nees_fraction_in_95"] == pytest.approx(63 / 79, rel=1e-5)
+    assert m["classification_accuracy"] == pytest.approx(63 / 79, rel=1e-5)
+
+
+def test_detection_latency_switches_and_false_targets(synthetic):
+    _, m = synthetic
+    # in range: alpha, bravo, charlie (radar) and echo (AIS) at 21 epochs; delta never
+    assert m["in_range_pairs"] == 84 and m["matched_pairs"] == 79
+    assert m["detection_rate"] == pytest.approx(79 / 84, rel=1e-5)
+    assert m["detection_latency_s"] == {"alpha": 0.0, "bravo": 0.0, "charlie": 5.0, "echo": 0.0}
+    assert m["detection_latency_max_s"] == 5.0
+    assert m["missed_objects"] == []
+    assert m["id_switches"] == 1 and m["id_switches_max_per_object"] == 1
+    assert m["false_target_ids"] == [99]
+    assert m["false_targets_per_min"] == pytest.approx(1 / (DURATION_S / 60))
+    assert m["false_reports"] == 21
+    assert m["false_reports_per_min"] == pytest.approx(21 / (DURATION_S / 60))
+    rows = {o["name"]: o for o in m["per_object"]}
+    assert set(rows) == {"alpha", "bravo", "charlie", "echo"}
+    assert rows["bravo"]["target_ids"] == [2, 7] and rows["bravo"]["id_switches"] == 1
+    assert rows["charlie"]["matched_fraction"] == pytest.approx(16 / 21, rel=1e-5)
+    assert rows["charlie"]["first_in_range_s"] == 0.0 and rows["charlie"]["latency_s"] == 5.0
+
+
+def test_false_target_is_one_matched_at_fewer_than_half_its_epochs(tmp_path):
+    def lines(frame):
+        out = []
+        for t in range(21):
+            truth = {o[1]: o for o in _objects(float(t))}
+            a, b, ch = truth["alpha"], truth["bravo"], truth["charlie"]
+            out.append(_line(frame, float(t), a[3], a[4], target_id=1))
+            # 40: on bravo at 7 of its 21 epochs (false); 41: on charlie at 14 of 21 (not false)
+            out.append(_line(frame, float(t), *((b[3], b[4]) if t < 7 else (0.0, -700.0)), target_id=40))
+            out.append(_line(frame, float(t), *((ch[3], ch[4]) if t < 14 else (0.0, -800.0)), target_id=41))
+        return out
+
+    m = evaluate(make_recording(tmp_path / "rec", targets=lines, tracks=False))
+    assert m["false_target_ids"] == [40]
+    assert m["false_reports"] == 14 + 7
+    assert m["missed_objects"] == ["echo"] and m["detection_latency_s"]["echo"] is None
+    assert m["detection_rate"] == pytest.approx((21 + 7 + 14) / 84, rel=1e-5)
+    assert m["nees"] is None and m["cog_rmse_deg"] is None  # no covariance, no COG reported
+    assert m["position_rmse_m"] == pytest.approx(0.0, abs=1e-4)
+
+
+def test_ospa_and_gospa_means(synthetic):
+    _, m = synthetic
+    # t < 5: 4 truths, 4 targets, 3 pairs at 3 m, charlie vs the false target beyond c
+    # t >= 5: 4 truths, 5 targets, 4 pairs at 3 m, one false target
+    ospa_early, ospa_late = math.sqrt((3 * 9 + C ** 2) / 4), math.sqrt((4 * 9 + C ** 2) / 5)
+    gospa_early, gospa_late = math.sqrt(3 * 9 + C ** 2 / 2 * 2), math.sqrt(4 * 9 + C ** 2 / 2)
+    assert m["ospa_m"] == pytest.approx((5 * ospa_early + 16 * ospa_late) / 21, rel=1e-5)
+    assert m["gospa_m"] == pytest.approx((5 * gospa_early + 16 * gospa_late) / 21, rel=1e-5)
+    s = m["series"]
+    assert len(s["t_s"]) == 21 and s["ospa_m"][0] == pytest.approx(ospa_early, rel=1e-5)
+    assert s["n_in_range"] == [4] * 21 and s["n_reports"] == [4] * 5 + [5] * 16
+    assert len(s["pairs"]["error_m"]) == 79
+
+
+def test_per_sensor_metrics_use_each_sensors_range(synthetic):
+    _, m = synthetic
+    ais, radar = m["per_sensor"]["ais"], m["per_sensor"]["radar"]
+    assert "per_sensor" not in ais and "series" not in ais
+    assert ais["position_rmse_m"] == pytest.approx(0.0, abs=1e-4)
+    assert ais["detection_rate"] == 1.0  # AIS sees alpha and echo only
+    assert ais["cog_rmse_deg"] == pytest.approx(0.0, abs=1e-6)
+    assert radar["position_rmse_m"] == pytest.approx(1.0, abs=1e-4)
+    assert radar["detection_rate"] == pytest.approx(21 / 63, rel=1e-5)  # radar range holds alpha, bravo, charlie
+    assert radar["nees"] == pytest.approx(1.0, rel=1e-4)
+
+
+def test_metrics_json_is_atomic_sorted_and_null_for_nan(synthetic, tmp_path):
+    rec, m = synthetic
+    out = write_metrics(rec, m)
+    assert out == rec / "tdm" / "metrics.json"
+    assert [p.name for p in out.parent.iterdir() if p.name.endswith(".tmp")] == []
+    text = out.read_text(encoding="utf-8")
+    loaded = json.loads(text)
+    assert loaded == m
+    assert list(loaded) == sorted(loaded)
+    assert "NaN" not in text and "Infinity" not in text
+    # nothing reported: NaN metrics become null
+    empty = make_recording(tmp_path / "empty", tracks=False)
+    (empty / "tdm" / "detected_targets.jsonl").write_text("", encoding="utf-8")
+    e = evaluate(empty)
+    assert e["position_rmse_m"] is None and e["nees"] is None and e["detection_rate"] == 0.0
+    assert e["ospa_m"] == pytest.approx(C) and e["gospa_m"] == pytest.approx(math.sqrt(4 * C ** 2 / 2))
+    assert e["missed_objects"] == ["alpha", "bravo", "charlie", "echo"]
+    assert e["detection_latency_s"]["charlie"] is None and e["per_sensor"] == {}
+    assert "null" in write_metrics(empty, e).read_text(encoding="utf-8")
+
+
+def test_format_table_names_metrics_sensors_and_objects(synthetic):
+    _, m = synthetic
+    table = format_table(m)
+    for word in ("OSPA", "GOSPA", "NEES", "fused", "ais", "radar", "alpha", "charlie", "5.0"):
+        assert word in table
+    assert "delta" not in table
+
+
+def test_missing_targets_and_bad_lines_are_recording_errors(tmp_path):
+    rec = make_recording(tmp_path / "rec", targets=False, tracks=False)
+    with pytest.raises(RecordingError) as err:
+        evaluate(rec)
+    assert err.value.file.endswith("detected_targets.jsonl") and "tdm run" in err.value.what
+    path = rec / "tdm" / "detected_targets.jsonl"
+    path.write_text('{"t": 0.0, "target_id": 1, "longitude": 10.47, "latitude": 59.43}\n\n'
+                    '{"t": 1.0, "target_id": 1, "longitude": 10.47}\n', encoding="utf-8")
+    with pytest.raises(RecordingError) as err:
+        evaluate(rec)
+    assert err.value.where == "line 3" and "latitude" in err.value.what
+    path.write_text("", encoding="utf-8")
+    (rec / "scenario.yaml").write_text("sensors: {radar: {range_m: far}}\n", encoding="utf-8")
+    with pytest.raises(RecordingError) as err:
+        evaluate(rec)
+    assert err.value.file.endswith("scenario.yaml") and err.value.where == "sensors.radar.range_m"
+
+
+def test_lidar_visibility_comes_from_the_sweeps_object_ids(tmp_path):
+    """LiDAR alone: an object is in range only within +-0.5 s of a point that hit it."""
+    rec = make_recording(tmp_path / "rec", sensors=("lidar",), tracks=False)
+    sweeps = rec / "lidar" / "sweeps"
+    sweeps.mkdir(parents=True)
+    for i, t0 in enumerate([3.0, 7.6, 12.0]):
+        t = t0 + np.linspace(0.0, 0.099, 100)
+        oid = np.full(100, -1, dtype=np.int32)
+        if t0 != 7.6:
+            oid[40:50] = 2  # bravo, at t0 + 0.04 .. t0 + 0.05 s
+        np.savez(sweeps / f"{i:06d}.npz", x=np.zeros(100, np.float32), time=t, object_id=oid)
+    m = evaluate(rec)
+    assert m["parameters"]["lidar_visibility"] == "hits"
+    assert m["in_range_pairs"] == 2 and m["matched_pairs"] == 2
+    rows = {o["name"]: o for o in m["per_object"]}
+    assert list(rows) == ["bravo"] and rows["bravo"]["first_in_range_s"] == 3.0
+    assert rows["bravo"]["latency_s"] == 0.0
+    assert m["id_switches"] == 1  # target 2 at t = 3, target 7 at t = 12
+    # sweeps without object_id: the LiDAR's range (200 m) stands in
+    for f in sweeps.iterdir():
+        np.savez(f, x=np.zeros(3, np.float32), time=np.zeros(3))
+    m = evaluate(rec)
+    assert m["parameters"]["lidar_visibility"] == "range"
+    assert {o["name"] for o in m["per_object"]} == {"alpha"}  # 100..117 m from the own ship
+
+
+def test_plots_are_deterministic_pngs(synthetic):
+    rec, m = synthetic
+    a = plot_tracks(rec)
+    b = plot_errors(rec, m)
+    assert a == rec / "tdm" / "tracks.png" and b == rec / "tdm" / "errors.png"
+    first = a.read_bytes(), b.read_bytes()
+    for data in first:
+        assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 10_000
+    plot_tracks(rec)
+    plot_errors(rec, m["series"])
+    assert (a.read_bytes(), b.read_bytes()) == first
+    write_metrics(rec, m)
+    other = plot_errors(rec, None, rec / "tdm" / "errors_again.png")
+    assert other.read_bytes() == first[1]
+
+
+def test_perfect_targets_on_a_rendered_recording(bos_recording, tmp_path):
+    """Targets placed on the truth of a real recording score zero error and full detection."""
+    rec = tmp_path / "rec"
+    (rec / "lidar").mkdir(parents=True)
+    for name in ("truth.jsonl", "scenario.yaml", "manifest.json"):
+        shutil.copy(bos_recording / name, rec / name)
+    os.symlink(bos_recording / "lidar" / "sweeps", rec / "lidar" / "sweeps")
+    (rec / "tdm").mkdir()
+    truth = [json.loads(line) for line in open(rec / "truth.jsonl", encoding="utf-8")]
+    with open(rec / "tdm" / "detected_targets.jsonl", "w", encoding="utf-8") as f:
+        for r in truth:
+            if r["kind"] != "ownship" and abs(r["t"] - round(r["t"])) < 1e-6:
+                f.write(json.dumps({"t": float(round(r["t"])), "target_id": 100 + r["id"],
+                                    "object_descriptor": {"ship": "vessel"}.get(r["kind"], r["kind"]),
+                                    "longitude": r["lon"], "latitude": r["lat"], "cog_deg": r["cog_deg"],
+                                    "sog_mps": r["sog_mps"], "cross_section_m2": 1.0, "sources": ["radar"],
+                                    "position_cov_m2": [[1.0, 0.0], [0.0, 1.0]]}) + "\n")
+    m = evaluate(rec)
+    assert m["parameters"]["lidar_visibility"] == "hits"
+    assert m["position_rmse_m"] == pytest.approx(0.0, abs=1e-3)
+    assert m["ospa_m"] == pytest.approx(0.0, abs=1e-3)
+    assert m["detection_rate"] == 1.0 and m["false_reports"] == 0 and m["id_switches"] == 0
+    assert m["detection_latency_max_s"] == 0.0
+    n_objects = len({r["id"] for r in truth if r["kind"] != "ownship"})
+    assert m["objects_in_range"] == n_objects  # the radar's 1852 m holds the whole scene

@@ -1,0 +1,70 @@
+"""Simple Fusion (thesis eq. 3.2), covariance intersection and target management."""
+
+import numpy as np
+import pytest
+
+from tdm import ekf
+from tdm.fusion import Fuser, FusionConfig, fuse
+from tdm.tracker import Track
+
+
+def test_simple_fusion_is_the_information_weighted_mean():
+    x1 = np.array([0.0, 0.0, 0.1, 5.0, 0.0, 10.0])
+    x2 = np.array([3.0, 6.0, 0.2, 5.5, 0.0, 20.0])
+    p1 = np.diag([1.0, 4.0, 0.01, 1.0, 1e-4, 100.0])
+    p2 = np.diag([2.0, 2.0, 0.04, 0.25, 1e-4, 100.0])
+    x, p = fuse(np.array([x1, x2]), np.array([p1, p2]))
+    assert x[0] == pytest.approx((0 / 1 + 3 / 2) / (1 / 1 + 1 / 2))
+    assert x[1] == pytest.approx((0 / 4 + 6 / 2) / (1 / 4 + 1 / 2))
+    assert p[0, 0] == pytest.approx(1 / (1 / 1 + 1 / 2))
+    assert np.all(np.diag(p) <= np.minimum(np.diag(p1), np.diag(p2)) + 1e-12)
+
+
+def test_fusion_of_courses_across_north():
+    x1 = np.array([0, 0, np.radians(359.0), 5, 0, 0.0])
+    x2 = np.array([0, 0, np.radians(3.0), 5, 0, 0.0])
+    p = np.eye(6)
+    x, _ = fuse(np.array([x1, x2]), np.array([p, p]))
+    assert np.degrees(ekf.wrap_pi(x[ekf.PSI])) == pytest.approx(1.0)
+
+
+def test_covariance_intersection_stays_wider_than_simple_fusion():
+    p1, p2 = np.diag([1.0, 4.0, 1, 1, 1, 1]), np.diag([4.0, 1.0, 1, 1, 1, 1])
+    xs = np.zeros((2, 6))
+    _, ps = fuse(xs, np.array([p1, p2]), "simple")
+    _, pc = fuse(xs, np.array([p1, p2]), "ci")
+    assert np.all(np.linalg.eigvalsh(pc - ps) > -1e-12)
+    # CI never claims more than the better input along any axis
+    assert pc[0, 0] >= 1.0 - 1e-12 and pc[1, 1] >= 1.0 - 1e-12
+
+
+def make_track(track_id, sensor, east, north, var=4.0, t=0.0, mmsi=None):
+    x = np.array([east, north, 0.0, 0.0, 0.0, 50.0])
+    p = np.diag([var, var, 1.0, 0.25, 1e-4, 100.0])
+    return Track(track_id, sensor, x, p, t, t, t, confirmed=True, mmsi=mmsi)
+
+
+def test_tracks_of_one_object_share_a_target_and_ids_stay_stable():
+    fuser = Fuser(FusionConfig())
+    radar = [make_track(1, "radar", 0.0, 0.0, var=25.0), make_track(2, "radar", 500.0, 0.0, var=25.0)]
+    out = fuser.step(1.0, {"radar": radar, "lidar": [], "ais": []})
+    ids = {round(e.x[0]): e.target.target_id for e in out}
+    # LiDAR and AIS tracks appear near the first object: same target, same id
+    lidar = [make_track(7, "lidar", 2.0, 1.0, var=1.0)]
+    ais = [make_track(3, "ais", -3.0, 2.0, var=5.0, mmsi=257000001)]
+    out = fuser.step(2.0, {"radar": radar, "lidar": lidar, "ais": ais})
+    assert len(out) == 2
+    first = [e for e in out if abs(e.x[0]) < 50][0]
+    assert first.target.target_id == ids[0]
+    assert first.sources == ["ais", "lidar", "radar"]
+    assert first.target.descriptor == "vessel" and first.target.mmsi == 257000001
+    # the radar track of the first object ends: the target lives on with its other tracks
+    out = fuser.step(3.0, {"radar": radar[1:], "lidar": lidar, "ais": ais})
+    assert sorted(e.target.target_id for e in out) == sorted(ids.values())
+
+
+def test_a_distant_track_of_a_new_object_starts_a_new_target():
+    fuser = Fuser(FusionConfig())
+    fuser.step(1.0, {"radar": [make_track(1, "radar", 0.0, 0.0)]})
+    out = fuser.step(2.0, {"radar": [make_track(1, "radar", 0.0, 0.0)], "lidar": [make_track(1, "lidar", 300.0, 0.0)]})
+    assert len(out) == 2

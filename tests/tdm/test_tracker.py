@@ -1,0 +1,93 @@
+"""Per-sensor trackers on synthetic detections with known truth."""
+
+import numpy as np
+import pytest
+
+from tdm import ekf
+from tdm.detections import AisReport, Detections
+from tdm.tracker import AisTracker, AisTrackerConfig, PositionTracker, TrackerConfig
+
+
+def scan(t, positions, sigma=1.0, area=50.0):
+    positions = np.atleast_2d(np.asarray(positions, dtype=float)).reshape(-1, 2)
+    n = len(positions)
+    d = Detections.empty("radar", t)
+    d.time_s = np.full(n, float(t))
+    d.position_m = positions
+    d.position_cov_m2 = np.tile(np.eye(2) * sigma**2, (n, 1, 1))
+    d.cross_section_m2 = np.full(n, area)
+    d.length_m = d.width_m = d.orientation_deg = d.range_m = np.zeros(n)
+    d.height_m = np.full(n, np.nan)
+    d.n_cells = np.ones(n, dtype=np.int64)
+    return d
+
+
+CFG = TrackerConfig(confirm_m=3, confirm_n=5, coast_s=5.0, position_floor_m2=0.0, max_range_m=1e4)
+
+
+def test_a_straight_mover_is_confirmed_and_its_course_and_speed_found():
+    rng = np.random.default_rng(0)
+    tracker = PositionTracker("radar", CFG)
+    course = np.radians(60.0)
+    for k in range(60):
+        t = k * 1.0
+        truth = 5.0 * t * np.array([np.sin(course), np.cos(course)]) + [100, 200]
+        tracker.process(scan(t, truth + rng.normal(size=2)), np.zeros(2))
+        if k == 1:
+            assert not tracker.confirmed_tracks()  # 2 hits: not yet 3 of 5
+    (track,) = tracker.confirmed_tracks()
+    assert track.x[ekf.U] == pytest.approx(5.0, abs=0.3)
+    assert np.degrees(ekf.wrap_pi(track.x[ekf.PSI] - course)) == pytest.approx(0.0, abs=3.0)
+    assert track.track_id == 1  # one track all along
+
+
+def test_gnn_keeps_two_close_targets_apart():
+    rng = np.random.default_rng(1)
+    tracker = PositionTracker("radar", CFG)
+    for k in range(40):
+        t = float(k)
+        a = np.array([0.0 + 4.0 * t, 0.0])  # eastbound
+        b = np.array([0.0 + 4.0 * t, 30.0])  # parallel, 30 m north
+        dets = np.array([b, a]) + rng.normal(size=(2, 2)) * 1.0
+        tracker.process(scan(t, dets[rng.permutation(2)]), np.zeros(2))
+    tracks = sorted(tracker.confirmed_tracks(), key=lambda tr: tr.x[ekf.N])
+    assert len(tracks) == 2
+    assert tracks[0].x[ekf.N] == pytest.approx(0.0, abs=3.0)
+    assert tracks[1].x[ekf.N] == pytest.approx(30.0, abs=3.0)
+
+
+def test_tracks_are_deleted_after_coasting_and_clutter_is_never_confirmed():
+    rng = np.random.default_rng(2)
+    tracker = PositionTracker("radar", CFG)
+    for k in range(20):
+        clutter = rng.uniform(-1000, 1000, size=(3, 2))  # fresh false plots every scan
+        pts = np.vstack([[[500.0, 500.0]], clutter]) if k < 10 else clutter
+        tracker.process(scan(float(k), pts), np.zeros(2))
+        if k == 9:
+            assert len(tracker.confirmed_tracks()) == 1
+    assert tracker.confirmed_tracks() == []  # the object left 10 s ago (> coast 5 s); clutter never confirmed
+
+
+def test_misses_outside_the_sensor_range_do_not_count():
+    cfg = TrackerConfig(confirm_m=3, confirm_n=5, coast_s=100.0, position_floor_m2=0.0, max_range_m=100.0)
+    tracker = PositionTracker("lidar", cfg)
+    for k in range(3):
+        tracker.process(scan(float(k), [[90.0, 0.0]]), np.zeros(2))
+    (track,) = tracker.confirmed_tracks()
+    hits = list(track.hits)
+    tracker.process(scan(3.0, np.zeros((0, 2))), np.array([-50.0, 0.0]))  # now 140 m away: out of view
+    assert list(track.hits) == hits
+
+
+def test_ais_tracks_are_kept_by_mmsi():
+    tracker = AisTracker(AisTrackerConfig())
+    for k in range(10):
+        t = 10.0 * k
+        for mmsi, north in ((257000001, 0.0), (257000002, 500.0)):
+            tracker.process(AisReport(t, mmsi, np.array([5.0 * t, north]), 90.0, 5.0, 90.0, 0.0, 1))
+    tracks = {tr.mmsi: tr for tr in tracker.confirmed_tracks()}
+    assert set(tracks) == {257000001, 257000002}
+    assert tracks[257000002].x[ekf.N] == pytest.approx(500.0, abs=2.0)
+    assert tracks[257000001].x[ekf.U] == pytest.approx(5.0, abs=0.2)
+    tracker.expire(90.0 + 201.0)
+    assert tracker.confirmed_tracks() == []
