@@ -37,7 +37,8 @@ class ProcessNoise:
     speed_m2_per_s3 : float
         Speed random walk, (m/s)^2/s: 0.02 lets a ship change speed by about 0.5 m/s in 10 s.
     turn_rate_rad2_per_s3 : float
-        Turn-rate random walk, (rad/s)^2/s.
+        Turn-rate random walk, (rad/s)^2/s: 1e-4 lets the turn rate reach 1.8 deg/s (one sigma) in
+        10 s, as a ship turning at a waypoint does (tuned on the Table 3.2 run: 1e-6 lagged the turns).
     cross_section_m4_per_s : float
         Cross-section drift, m^4/s (aspect changes).
     """
@@ -45,7 +46,7 @@ class ProcessNoise:
     position_m2_per_s: float = 0.05
     course_rad2_per_s: float = 1e-4
     speed_m2_per_s3: float = 0.02
-    turn_rate_rad2_per_s3: float = 1e-6
+    turn_rate_rad2_per_s3: float = 1e-4
     cross_section_m4_per_s: float = 20.0
 
 
