@@ -11,7 +11,9 @@ starting with ``"ais/nmea: "`` and the line or message is skipped):
 * Time: the TAG block's ``c:`` field, UNIX seconds (a value above 1e11 is taken as
   milliseconds, as some receivers write), minus the recording's start. A line without a
   TAG block time (or with a bad TAG block checksum) is counted and skipped: borrowing
-  the previous line's time would invent a time the receiver never gave.
+  the previous line's time would invent a time the receiver never gave. A time in whole
+  seconds stands for the second the sentence arrived in, so its middle (+0.5 s) is used:
+  unbiased, where the second's start is 0.5 s early on average (2.5 m at 5 m/s).
 * A bad sentence checksum, an unparsable line (garbage, non-ASCII, a sentence other
   than ``!xxVDM``/``!xxVDO``), a fragment without its partners (an orphan), a message too
   short for the fields read, a message type that is not used here, and a position report
@@ -100,7 +102,9 @@ def _tag_time_s(sentence) -> float | None:
         return None
     if not math.isfinite(value):
         return None
-    return value / 1000.0 if value > MILLISECOND_TIMES_ABOVE else value
+    if value > MILLISECOND_TIMES_ABOVE:
+        return value / 1000.0
+    return value + 0.5 if value == math.floor(value) else value  # a whole second: its middle
 
 
 def _payload_bits(sentence) -> int:

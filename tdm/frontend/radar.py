@@ -174,10 +174,13 @@ class RadarFrontEndConfig:
         extent).
     extent_sigma_fraction : float
         Standard deviation of the centroid about the target's centre per metre of the target's
-        visible extent. Default 0.5: the radar sees the near face, not the centre (the plots of
-        rendered icebergs lie 6-9 m short of their centres), so the centre lies about half the
-        target's depth behind its plot. With these two defaults the median normalised error
-        (NEES) about the truth centres of rendered recordings is 0.5-1.5 (ideal 1.39).
+        visible extent. Default 0.25. The radar sees the near face, not the centre (the plots of
+        rendered icebergs lie 6-9 m short of their centres), so the centre lies up to half the
+        target's depth behind its plot; but that offset is a bias that stays from sweep to sweep,
+        and the trackers treat the covariance as white noise: with 0.5 (median NEES about the
+        truth centres 0.5-1.5) the plots' real scatter (about 2 m on the Table 3.2 vessel) was
+        reported as 10 m and the radar tracks lagged every turn; 0.25 halves their heading error
+        (benchmarks/results/thesis_table32.md).
     range_scale_m, spokes, samples : float, int, int or None
         The sweep geometry the configuration is for (scenario ``sensors.radar``); when set,
         :func:`radar_detections` checks each sweep against it.
@@ -210,7 +213,7 @@ class RadarFrontEndConfig:
     range_resolution_m: float = 2.5
     blanking_m: float = 3.0
     bearing_sigma_beam_fraction: float = 0.15
-    extent_sigma_fraction: float = 0.5
+    extent_sigma_fraction: float = 0.25
     range_scale_m: float | None = None
     spokes: int | None = None
     samples: int | None = None

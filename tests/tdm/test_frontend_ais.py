@@ -72,8 +72,9 @@ def test_reports_and_static_data_of_a_rendered_recording(bos_recording):
         mine = [r for r in reports if r.mmsi == mmsi]
         assert len(mine) >= 3
         for r in mine:
-            # the TAG block time is the whole UNIX second: the report left within the second after it
-            at = r.time_s + 0.5
+            # the TAG block time is the whole UNIX second; the front end takes its middle
+            at = r.time_s
+            assert (at - 0.5) == pytest.approx(round(at - 0.5))
             east, north = frame.to_enu(np.interp(at, t, [row["lat"] for row in rows]),
                                        np.interp(at, t, [row["lon"] for row in rows]))
             assert np.hypot(r.position_m[0] - east, r.position_m[1] - north) < 20.0
@@ -186,7 +187,7 @@ def test_fields_of_hand_made_messages(tmp_path):
     by_mmsi = {r.mmsi: r for r in reports}
     for i, c in enumerate(codes):
         r = by_mmsi[257000100 + i]
-        assert r.time_s == 10 + i and r.msg_type == 1
+        assert r.time_s == 10 + i + 0.5 and r.msg_type == 1  # the middle of the whole second
         if c in (-128, 127, -127):
             assert math.isnan(r.rot_deg_per_min)
         else:
