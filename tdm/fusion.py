@@ -45,6 +45,7 @@ class FusionConfig:
     rule: str = "simple"  # "simple" (thesis eq. 3.2) or "ci" (covariance intersection)
     min_extent_m: float = 10.0  # smallest absorbing radius of a target, m
     absorb_lengths: float = 0.75  # absorbing radius in target lengths
+    revive_s: float = 30.0  # a new track where a target ended less than this ago takes its id
     gate_probability: float = 0.9999
     max_distance_m: float = 60.0
     vessel_speed_mps: float = 1.0
@@ -60,6 +61,9 @@ class FusedTarget:
     target_id: int
     members: dict[str, int] = field(default_factory=dict)  # sensor -> track id
     absorbed: set = field(default_factory=set)  # (sensor, track id) of extra tracks on this object
+    last_x: np.ndarray | None = None  # the last fused state (6,) reported, and its time
+    last_t_s: float = 0.0
+    radius_m: float = 0.0  # its absorbing radius then
     created_s: float = 0.0
     descriptor: str = "unknown"
     mmsi: int | None = None
@@ -114,6 +118,7 @@ class Fuser:
         self.config = config
         self.targets: list[FusedTarget] = []
         self.lengths_by_mmsi: dict[int, float] = {}
+        self._ended: list[FusedTarget] = []
         self._ids = itertools.count(1)
         self._gate = chi2_gate(config.gate_probability, 2)
         self._moving_since: dict[int, float] = {}
@@ -131,10 +136,14 @@ class Fuser:
             if len(target.members) > 1:
                 self._split_inconsistent(target, states)
             claimed.update(target.members.items())
-        self.targets = [t for t in self.targets if t.members]
-        extents = {t.target_id: (self._estimate(t, states), self._half_length(t, live)) for t in self.targets}
         for target in self.targets:
-            (x, _), half = extents[target.target_id]
+            if not target.members and target.last_x is not None:
+                self._ended.append(target)
+        self._ended = [t for t in self._ended if t_s - t.last_t_s <= cfg.revive_s]
+        self.targets = [t for t in self.targets if t.members]
+        for target in self.targets:
+            x, _ = self._estimate(target, states)
+            half = self._half_length(target, live)
             target.absorbed = {k for k in target.absorbed if k in live and k not in claimed
                                and self._inside(states[k], x, half)}
             claimed.update(target.absorbed)
@@ -163,15 +172,19 @@ class Fuser:
                 if fi in joined:
                     continue
                 key = (sensor, tr.track_id)
-                host = next((t for t in self.targets if t.target_id in extents
-                             and self._inside(states[key], extents[t.target_id][0][0], extents[t.target_id][1])), None)
+                host = next((t for t in self.targets
+                             if self._inside(states[key], self._estimate(t, states)[0], self._half_length(t, live))), None)
                 if host is not None:
                     host.absorbed.add(key)
                 else:
-                    self.targets.append(FusedTarget(next(self._ids), {sensor: tr.track_id}, created_s=t_s))
+                    self.targets.append(self._revive(states[key], t_s) or
+                                        FusedTarget(next(self._ids), created_s=t_s))
+                    self.targets[-1].members = {sensor: tr.track_id}
+        self._merge_overlapping(states, live)
         out = []
         for target in self.targets:
             x, p = self._estimate(target, states)
+            target.last_x, target.last_t_s, target.radius_m = x, t_s, self._half_length(target, live)
             ais_track = live.get(("ais", target.members.get("ais", -1)))
             target.mmsi = ais_track.mmsi if ais_track is not None else target.mmsi
             heights = [live[(s, i)].height_m for s, i in target.members.items() if s == "lidar"]
@@ -197,8 +210,75 @@ class Fuser:
         sigma = np.sqrt(max(np.linalg.eigvalsh(p[:2, :2])[-1], 0.0))
         return bool(np.hypot(*(x[:2] - centre[:2])) <= half_length_m + 3.0 * sigma)
 
+    def _revive(self, state, t_s: float) -> FusedTarget | None:
+        """The recently ended target whose footprint (its last state predicted to ``t_s``) holds ``state``."""
+        best, best_d = None, np.inf
+        for target in self._ended:
+            centre = ekf.predict_mean(target.last_x, t_s - target.last_t_s)
+            if self._inside(state, centre, target.radius_m):
+                d = float(np.hypot(*(state[0][:2] - centre[:2])))
+                if d < best_d:
+                    best, best_d = target, d
+        if best is not None:
+            self._ended.remove(best)
+            best.absorbed = set()
+        return best
+
+    def _merge_overlapping(self, states, live) -> None:
+        """Fold a target into an older one when both are the same object.
+
+        Same object: one lies inside the other's footprint (as for absorbing tracks) and either
+        exactly one of them has an AIS track (a radar or LiDAR target of an AIS ship), or neither
+        has and they move alike (within 2 m/s). The older target keeps its id; the younger's
+        tracks fill the sensors the older lacks and are absorbed otherwise.
+        """
+        targets = sorted(self.targets, key=lambda t: (t.created_s, t.target_id))
+        gone: set[int] = set()
+        for i, older in enumerate(targets):
+            if older.target_id in gone:
+                continue
+            for younger in targets[i + 1:]:
+                if younger.target_id in gone:
+                    continue
+                xo, po = self._estimate(older, states)
+                xy, py = self._estimate(younger, states)
+                radius = max(self._half_length(older, live), self._half_length(younger, live))
+                if not self._inside((xy, py), xo, radius):
+                    continue
+                n_ais = ("ais" in older.members) + ("ais" in younger.members)
+                if n_ais == 2:
+                    continue
+                if n_ais == 0:
+                    vo = xo[ekf.U] * np.array([np.sin(xo[ekf.PSI]), np.cos(xo[ekf.PSI])])
+                    vy = xy[ekf.U] * np.array([np.sin(xy[ekf.PSI]), np.cos(xy[ekf.PSI])])
+                    if np.hypot(*(vo - vy)) > 2.0:
+                        continue
+                for sensor, track_id in younger.members.items():
+                    if sensor in older.members:
+                        older.absorbed.add((sensor, track_id))
+                    else:
+                        older.members[sensor] = track_id
+                older.absorbed |= younger.absorbed
+                if older.descriptor == "unknown":
+                    older.descriptor = younger.descriptor
+                gone.add(younger.target_id)
+        self.targets = [t for t in self.targets if t.target_id not in gone]
+
     def _split_inconsistent(self, target: FusedTarget, states) -> None:
-        """Release members that have drifted away from the target's other tracks."""
+        """Release members that have drifted away from the target's other tracks.
+
+        An AIS track is the target's identity: when there is one, the other members are checked
+        against it and released if inconsistent; the AIS track itself is never released.
+        """
+        if "ais" in target.members:
+            ais_key = ("ais", target.members["ais"])
+            xa, pa = states[ais_key]
+            for key in [k for k in target.members.items() if k[0] != "ais"]:
+                xi, pi_ = states[key]
+                d = xi[:2] - xa[:2]
+                if mahalanobis2(d, pi_[:2, :2] + pa[:2, :2]) > 4 * self._gate or np.hypot(*d) > 2 * self.config.max_distance_m:
+                    del target.members[key[0]]
+            return
         keys = list(target.members.items())
         for key in keys:
             others = [k for k in target.members.items() if k != key]

@@ -68,3 +68,27 @@ def test_a_distant_track_of_a_new_object_starts_a_new_target():
     fuser.step(1.0, {"radar": [make_track(1, "radar", 0.0, 0.0)]})
     out = fuser.step(2.0, {"radar": [make_track(1, "radar", 0.0, 0.0)], "lidar": [make_track(1, "lidar", 300.0, 0.0)]})
     assert len(out) == 2
+
+
+def test_a_new_track_where_a_target_just_ended_takes_its_id():
+    fuser = Fuser(FusionConfig(revive_s=30.0))
+    (first,) = fuser.step(1.0, {"radar": [make_track(1, "radar", 500.0, 0.0)]})
+    fuser.step(2.0, {"radar": []})  # the weak echo was lost: the target ends
+    (again,) = fuser.step(10.0, {"radar": [make_track(2, "radar", 503.0, 2.0, t=10.0)]})
+    assert again.target.target_id == first.target.target_id
+    fuser.step(11.0, {"radar": []})
+    (late,) = fuser.step(50.0, {"radar": [make_track(3, "radar", 500.0, 0.0, t=50.0)]})  # 39 s later: new
+    assert late.target.target_id != first.target.target_id
+    (elsewhere,) = fuser.step(51.0, {"radar": [make_track(4, "radar", 900.0, 0.0, t=51.0)]})
+    assert elsewhere.target.target_id not in (first.target.target_id, late.target.target_id)
+
+
+def test_a_radar_target_inside_an_ais_ship_folds_into_the_older_target():
+    fuser = Fuser(FusionConfig())
+    fuser.lengths_by_mmsi = {257000002: 100.0}
+    (radar_only,) = fuser.step(1.0, {"radar": [make_track(1, "radar", 40.0, 0.0, var=100.0)]})
+    # the ship's AIS track arrives 40 m away (the radar sees the bow): one object, the older id
+    out = fuser.step(2.0, {"radar": [make_track(1, "radar", 40.0, 0.0, var=100.0)],
+                           "ais": [make_track(5, "ais", 0.0, 0.0, var=5.0, mmsi=257000002)]})
+    assert len(out) == 1 and out[0].target.target_id == radar_only.target.target_id
+    assert out[0].target.mmsi == 257000002
