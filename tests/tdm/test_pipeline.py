@@ -80,7 +80,7 @@ def test_crossing_with_a_silent_ship_meets_the_done_criteria(crossing):
 
 def test_busy_open_sea_meets_the_accuracy_and_false_target_criteria(busy):
     _, metrics = busy
-    check_done_when(metrics, latency_limit_s=30.0, false_per_min=2.5)
+    check_done_when(metrics, latency_limit_s=30.0, false_per_min=2.0)
 
 
 @pytest.mark.xfail(strict=True, reason="weak icebergs at 550-700 m in sea state 4 and bergs whose radar echoes "
@@ -90,7 +90,7 @@ def test_busy_open_sea_reports_every_object_within_10_s(busy):
     assert metrics["detection_latency_max_s"] <= 10.0
 
 
-@pytest.mark.xfail(strict=True, reason="sea-state-4 clutter at 700-1000 m forms about 2 radar-only false targets "
+@pytest.mark.xfail(strict=True, reason="sea-state-4 clutter at 600-1000 m forms 1-3 radar-only false targets "
                    "per minute (docs/tdm.md, known limits)")
 def test_busy_open_sea_has_at_most_one_false_target_per_minute(busy):
     _, metrics = busy
