@@ -60,7 +60,9 @@ def run_command(recording: Path, out: Path | None = None, fusion: str = "simple"
 def evaluate_command(recording: Path, plots: bool = True) -> dict:
     """``tdm evaluate`` as a function: metrics.json and the plots; returns the metrics."""
     from tdm.evaluate import evaluate, write_metrics
+    from tdm.io import read_manifest
 
+    read_manifest(recording)  # a recording directory at all?
     metrics = evaluate(recording)
     write_metrics(recording, metrics)
     if plots:
