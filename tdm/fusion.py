@@ -20,7 +20,10 @@
   weights ``w_i = (1/tr P_i) / sum_j (1/tr P_j)`` (Niehsen 2002):
   ``P^-1 = sum_i w_i P_i^-1``, ``x = P sum_i w_i P_i^-1 x_i``.
 - **Classes.** ``vessel``: it has an AIS track, or it has moved at over ``vessel_speed_mps``
-  with confidence; ``iceberg``: stationary for ``settle_s`` with a footprint over
+  with confidence (by two standard deviations, for 5 s); stationary: speed under half of
+  ``vessel_speed_mps`` with a standard deviation under it (two sigmas were too strict: radar
+  tracks of still bergs keep about 0.5 m/s of speed uncertainty); ``iceberg``: stationary for
+  ``settle_s`` with a footprint over
   ``iceberg_area_m2`` or a LiDAR height over ``iceberg_height_m``; ``fixed obstacle``: stationary
   and smaller; else ``unknown``. A class once given to a target is kept unless a vessel
   is seen.
@@ -307,7 +310,7 @@ class Fuser:
             self._moving_since.pop(tid, None)
         if target.descriptor == "vessel":
             return
-        if abs(speed) + 2 * sigma < cfg.vessel_speed_mps:
+        if abs(speed) < 0.5 * cfg.vessel_speed_mps and sigma < cfg.vessel_speed_mps:
             self._still_since.setdefault(tid, t_s)
             if t_s - self._still_since[tid] >= cfg.settle_s:
                 big = x[ekf.ALPHA] >= cfg.iceberg_area_m2 or (np.isfinite(height_m) and height_m >= cfg.iceberg_height_m)
