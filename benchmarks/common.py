@@ -68,3 +68,28 @@ def publish(title: str, intro: list[str], rows: list[tuple[str, str]], out: Path
     out.write_text(text, encoding="utf-8")
     if json_path:
         json_path.write_text(json.dumps(figures, indent=2) + "\n", encoding="utf-8")
+
+
+def ensure_recording(scenario: Path, out: Path, duration_s: float, fresh: bool = False) -> tuple[Path, float | None]:
+    """Render ``scenario`` for ``duration_s`` into ``out`` unless a matching render is there.
+
+    Returns the recording and the render's wall time (None when reused). A render is reused when
+    its manifest says the same scenario name and duration and it is newer than the scenario file.
+    """
+    import shutil
+
+    import yaml
+
+    manifest = out / "manifest.json"
+    if not fresh and manifest.is_file():
+        m = json.loads(manifest.read_text(encoding="utf-8"))
+        name = yaml.safe_load(scenario.read_text(encoding="utf-8")).get("name")
+        if (m.get("scenario") == name and abs(float(m.get("duration_s", -1)) - duration_s) < 1e-6
+                and manifest.stat().st_mtime > scenario.stat().st_mtime):
+            return out, None
+    if out.exists():
+        shutil.rmtree(out)
+    start = time.perf_counter()
+    subprocess.run([sys.executable, "-m", "raysim.cli", "render", str(scenario), "-o", str(out),
+                    "--duration", str(duration_s), "--no-progress"], check=True, cwd=ROOT, stdout=subprocess.DEVNULL)
+    return out, time.perf_counter() - start

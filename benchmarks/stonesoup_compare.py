@@ -58,7 +58,6 @@ import datetime as dt
 import json
 import math
 import shutil
-import subprocess
 import sys
 import tempfile
 import time
@@ -70,12 +69,12 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from benchmarks.common import machine_line, publish  # noqa: E402
+from benchmarks.common import ensure_recording, machine_line, publish  # noqa: E402
 from tdm.detections import AisReport, ReadStats  # noqa: E402
 from tdm.evaluate import evaluate  # noqa: E402
-from tdm.io import read_manifest  # noqa: E402
+from tdm.io import read_manifest, read_scenario  # noqa: E402
 from tdm.metrics import DEFAULT_CUTOFF_M, DEFAULT_ORDER_P, GOSPA_ALPHA  # noqa: E402
-from tdm.pipeline import DetectionStream, TdmConfig, read_scenario, run_tdm  # noqa: E402
+from tdm.pipeline import DetectionStream, TdmConfig, run_tdm  # noqa: E402
 
 #: Recordings compared: (scenario file stem, directory name under the work directory).
 RECORDINGS = (("busy_open_sea", "ss_bos"), ("crossing_silent_ship", "ss_css"))
@@ -139,25 +138,6 @@ def settings_from(config: TdmConfig, floor: bool) -> dict[str, SensorSettings]:
 
 
 # ---- recordings and scoring directories -------------------------------------------------------
-
-def ensure_recording(scenario: str, out: Path, duration_s: float, fresh: bool = False) -> Path:
-    """``out`` holding a ``raysim render`` of ``scenarios/<scenario>.yaml`` for ``duration_s`` (rendered if not).
-
-    ``fresh``: a recording of that scenario already in ``out`` is removed and rendered again.
-    """
-    manifest = out / "manifest.json"
-    if fresh and manifest.is_file() and json.loads(manifest.read_text(encoding="utf-8")).get("scenario") == scenario:
-        shutil.rmtree(out)
-    if manifest.is_file():
-        m = json.loads(manifest.read_text(encoding="utf-8"))
-        if m.get("scenario") == scenario and abs(float(m.get("duration_s", -1)) - duration_s) < 1e-6:
-            return out
-        raise SystemExit(f"{out} holds another recording ({m.get('scenario')}, {m.get('duration_s')} s): "
-                         "give another --workdir")
-    subprocess.run([sys.executable, "-m", "raysim.cli", "render", str(ROOT / "scenarios" / f"{scenario}.yaml"),
-                    "-o", str(out), "--duration", str(duration_s), "--no-progress"], check=True, cwd=ROOT)
-    return out
-
 
 def scoring_dir(recording: Path, out: Path) -> Path:
     """A directory ``tdm.evaluate.evaluate`` can read: the recording's files linked, an empty ``tdm/``."""
@@ -381,8 +361,8 @@ def compare(recording: Path, workdir: Path, q_values=Q_SWEEP, floor: bool = Fals
         ``duration_s``; ``rate_hz``.
     """
     recording = Path(recording)
-    rate_hz = float((read_scenario(recording).get("tdm") or {}).get("update_rate_hz", 1.0))
-    config = config or TdmConfig(update_rate_hz=rate_hz)
+    config = config or TdmConfig.for_recording(recording)
+    rate_hz = config.update_rate_hz
     workdir = Path(workdir)
     ours, ours_wall = run_ours(recording, workdir, config)
     events, stream = read_events(recording, config)
@@ -443,7 +423,8 @@ def main(argv=None) -> int:
     results = {}
     for scenario, dirname in RECORDINGS:
         suffix = "" if duration_s == 120.0 else f"_{duration_s:g}s"
-        rec = ensure_recording(scenario, args.workdir / f"{dirname}{suffix}", duration_s, args.fresh)
+        rec, _ = ensure_recording(ROOT / "scenarios" / f"{scenario}.yaml", args.workdir / f"{dirname}{suffix}", duration_s,
+                                  args.fresh)
         results[scenario] = compare(rec, args.workdir / f"{dirname}{suffix}_compare", q_values, args.floor)
         results[scenario]["recording"] = str(rec)
     import stonesoup

@@ -36,7 +36,6 @@ import subprocess
 import sys
 import tempfile
 import time
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -45,14 +44,13 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from benchmarks.common import machine_line, publish  # noqa: E402
-from benchmarks.thesis_table32 import ensure_recording  # noqa: E402
+from benchmarks.common import ensure_recording, machine_line, publish  # noqa: E402
 from tdm.detections import ReadStats  # noqa: E402
 from tdm.frames import Mount  # noqa: E402
 from tdm.frontend.lidar import LidarFrontEndConfig, lidar_detections  # noqa: E402
 from tdm.frontend.radar import RadarFrontEndConfig, radar_detections  # noqa: E402
-from tdm.io import read_manifest  # noqa: E402
-from tdm.pipeline import LIDAR_FIELDS, RADAR_FIELDS, DetectionStream, TdmConfig, read_scenario, run_tdm  # noqa: E402
+from tdm.io import read_manifest, read_scenario  # noqa: E402
+from tdm.pipeline import LIDAR_FIELDS, RADAR_FIELDS, DetectionStream, TdmConfig, run_tdm  # noqa: E402
 
 SCENARIO = ROOT / "scenarios" / "busy_open_sea.yaml"
 #: Asked of the TDM (issue): at least this multiple of real time on this 2-core machine.
@@ -63,18 +61,16 @@ _MEMORY_CHILD = """
 import resource, sys
 from dataclasses import replace
 from pathlib import Path
-from tdm.pipeline import TdmConfig, read_scenario, run_tdm
+from tdm.pipeline import TdmConfig, run_tdm
 rec, out, workers = Path(sys.argv[1]), Path(sys.argv[2]), int(sys.argv[3])
-rate = float((read_scenario(rec).get("tdm") or {}).get("update_rate_hz", 1.0))
-run_tdm(rec, out, TdmConfig(update_rate_hz=rate, workers=workers))
+run_tdm(rec, out, TdmConfig.for_recording(rec, workers=workers))
 print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024.0)
 """
 
 
 def config_for(recording: Path, workers: int) -> TdmConfig:
     """``tdm run``'s default configuration (rate from the scenario) with ``workers`` front-end processes."""
-    rate = float((read_scenario(recording).get("tdm") or {}).get("update_rate_hz", 1.0))
-    return replace(TdmConfig(update_rate_hz=rate), workers=workers)
+    return TdmConfig.for_recording(recording, workers=workers)
 
 
 def _cpu_s() -> tuple[float, float]:

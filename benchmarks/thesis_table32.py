@@ -29,9 +29,7 @@ scenario file (``--fresh`` renders again).
 from __future__ import annotations
 
 import argparse
-import json
 import math
-import subprocess
 import sys
 import time
 from pathlib import Path
@@ -42,7 +40,7 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from benchmarks.common import machine_line, publish  # noqa: E402
+from benchmarks.common import ensure_recording, machine_line, publish  # noqa: E402
 from tdm.evaluate import read_truth_enu  # noqa: E402
 from tdm.frames import EnuFrame  # noqa: E402
 from tdm.io import read_jsonl  # noqa: E402
@@ -353,31 +351,6 @@ def raw_table(raw: dict) -> list[str]:
 
 
 # ------------------------------------------------------------------------------------------ rendering and report
-
-
-def ensure_recording(scenario: Path, out: Path, duration_s: float, fresh: bool = False) -> tuple[Path, float | None]:
-    """Render ``scenario`` for ``duration_s`` into ``out`` unless a matching render is there.
-
-    Returns the recording and the render's wall time (None when reused). A render is reused when
-    its manifest says the same scenario name and duration and it is newer than the scenario file.
-    """
-    manifest = out / "manifest.json"
-    if not fresh and manifest.is_file():
-        m = json.loads(manifest.read_text(encoding="utf-8"))
-        import yaml
-
-        name = yaml.safe_load(scenario.read_text(encoding="utf-8")).get("name")
-        if (m.get("scenario") == name and abs(float(m.get("duration_s", -1)) - duration_s) < 1e-6
-                and manifest.stat().st_mtime > scenario.stat().st_mtime):
-            return out, None
-    if out.exists():
-        import shutil
-
-        shutil.rmtree(out)
-    start = time.perf_counter()
-    subprocess.run([sys.executable, "-m", "raysim.cli", "render", str(scenario), "-o", str(out),
-                    "--duration", str(duration_s), "--no-progress"], check=True, cwd=ROOT, stdout=subprocess.DEVNULL)
-    return out, time.perf_counter() - start
 
 
 def _fmt(x: float, digits: int = 3) -> str:

@@ -11,7 +11,6 @@ Bad input: one line on stderr naming the file, the place and what is wrong, exit
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import sys
 from pathlib import Path
 
@@ -48,12 +47,10 @@ def run_command(recording: Path, out: Path | None = None, fusion: str = "simple"
                 workers: int = 2, progress: bool | None = None):
     """``tdm run`` as a function (used by ``raysim run``)."""
     from tdm.io import read_manifest
-    from tdm.pipeline import TdmConfig, read_scenario, run_tdm
+    from tdm.pipeline import TdmConfig, run_tdm
 
     read_manifest(recording)  # a recording directory at all?
-    rate = float((read_scenario(recording).get("tdm") or {}).get("update_rate_hz", 1.0))
-    config = dataclasses.replace(TdmConfig(update_rate_hz=rate), fusion=fusion, lidar_source=lidar_source,
-                                 workers=max(0, int(workers)))
+    config = TdmConfig.for_recording(recording, fusion=fusion, lidar_source=lidar_source, workers=max(0, int(workers)))
     return run_tdm(recording, out, config, progress=sys.stderr.isatty() if progress is None else progress)
 
 

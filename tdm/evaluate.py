@@ -82,11 +82,10 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import yaml
 
 from tdm.errors import RecordingError
 from tdm.frames import EnuFrame
-from tdm.io import read_jsonl, read_manifest
+from tdm.io import read_jsonl, read_manifest, read_scenario
 from tdm.metrics import DEFAULT_CUTOFF_M, DEFAULT_ORDER_P, GOSPA_ALPHA, assign_distances, distance_matrix, \
     gospa_distances, ospa_distances
 
@@ -263,20 +262,6 @@ def read_reports(path: Path, frame: EnuFrame, with_sensor: bool = False) -> dict
     if with_sensor:
         out["sensor"] = _column(rows, "sensor", path, object)
     return out
-
-
-def _read_scenario(recording: Path) -> dict:
-    path = Path(recording) / "scenario.yaml"
-    try:
-        data = yaml.safe_load(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise RecordingError(str(path), "(file)", "missing") from None
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        raise RecordingError(str(path), f"line {mark.line + 1}" if mark else "(file)", "not valid YAML") from None
-    if not isinstance(data, dict):
-        raise RecordingError(str(path), "(file)", "not a mapping")
-    return data
 
 
 def _lidar_hit_times(recording: Path) -> dict[int, np.ndarray] | None:
@@ -710,7 +695,7 @@ def evaluate(recording: Path, c_m: float = DEFAULT_CUTOFF_M, p: float = DEFAULT_
     if not targets_path.is_file():
         raise RecordingError(str(targets_path), "(file)", "missing: run `tdm run` first")
     manifest = read_manifest(recording)
-    scenario = _read_scenario(recording)
+    scenario = read_scenario(recording)
     frame, truth_rows = read_truth_enu(recording)
     targets = read_reports(targets_path, frame)
     tracks_path = recording / "tdm" / "sensor_tracks.jsonl"

@@ -10,6 +10,7 @@ import json
 from pathlib import Path
 
 import numpy as np
+import yaml
 
 from tdm.errors import RecordingError
 
@@ -64,3 +65,18 @@ def read_ownship(recording: Path) -> dict[str, np.ndarray]:
 def read_truth(recording: Path) -> list[dict]:
     """truth.jsonl rows (only evaluation may use truth)."""
     return read_jsonl(Path(recording) / "truth.jsonl")
+
+
+def read_scenario(recording: Path) -> dict:
+    """The recording's resolved scenario.yaml (sensor mounts, own-ship size, TDM rate)."""
+    path = Path(recording) / "scenario.yaml"
+    try:
+        data = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise RecordingError(str(path), "(file)", "missing: not a recording directory") from None
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        raise RecordingError(str(path), f"line {mark.line + 1}" if mark else "(file)", "not valid YAML") from None
+    if not isinstance(data, dict):
+        raise RecordingError(str(path), "(top level)", "must be a mapping")
+    return data

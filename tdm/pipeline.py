@@ -23,7 +23,6 @@ from pathlib import Path
 from typing import Iterator
 
 import numpy as np
-import yaml
 
 from tdm.detections import Detections, ReadStats
 from tdm.errors import RecordingError
@@ -32,7 +31,7 @@ from tdm.frontend.ais import read_ais
 from tdm.frontend.lidar import LidarFrontEndConfig, lidar_detections
 from tdm.frontend.radar import RadarFrontEndConfig, radar_detections
 from tdm.fusion import Fuser, FusionConfig
-from tdm.io import read_manifest, read_ownship
+from tdm.io import read_manifest, read_ownship, read_scenario
 from tdm.messages import jsonl_writer, target_record
 from tdm.tracker import AisTracker, AisTrackerConfig, PositionTracker, TrackerConfig
 
@@ -72,6 +71,12 @@ class TdmConfig:
     ais_tracker: AisTrackerConfig = field(default_factory=AisTrackerConfig)
     fusion_config: FusionConfig = field(default_factory=FusionConfig)
 
+    @classmethod
+    def for_recording(cls, recording: Path, **changes) -> "TdmConfig":
+        """The defaults with ``update_rate_hz`` from the recording's scenario.yaml, then ``changes``."""
+        rate = float((read_scenario(recording).get("tdm") or {}).get("update_rate_hz", 1.0))
+        return cls(**{"update_rate_hz": rate, **changes})
+
 
 @dataclass
 class RunResult:
@@ -83,21 +88,6 @@ class RunResult:
     n_targets: int
     scans: dict[str, int]
     warnings: dict[str, int]
-
-
-def read_scenario(recording: Path) -> dict:
-    """The recording's resolved scenario.yaml (sensor mounts, own-ship size, TDM rate)."""
-    path = Path(recording) / "scenario.yaml"
-    try:
-        data = yaml.safe_load(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise RecordingError(str(path), "(file)", "missing: not a recording directory") from None
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        raise RecordingError(str(path), f"line {mark.line + 1}" if mark else "(file)", "not valid YAML") from None
-    if not isinstance(data, dict):
-        raise RecordingError(str(path), "(top level)", "must be a mapping")
-    return data
 
 
 def start_time_unix_s(manifest: dict, recording: Path) -> float:
@@ -331,9 +321,7 @@ def run_tdm(recording: Path, out_dir: Path | None = None, config: TdmConfig | No
     rec = Path(recording)
     manifest = read_manifest(rec)
     scenario = read_scenario(rec)
-    if config is None:
-        rate = float((scenario.get("tdm") or {}).get("update_rate_hz", 1.0))
-        config = TdmConfig(update_rate_hz=rate)
+    config = config if config is not None else TdmConfig.for_recording(rec)
     if config.update_rate_hz <= 0:
         raise RecordingError(str(rec / "scenario.yaml"), "tdm.update_rate_hz", "must be > 0")
     out = Path(out_dir) if out_dir is not None else rec / "tdm"

@@ -15,7 +15,6 @@ import numpy as np
 import pytest
 
 from tdm.cli import main as tdm_main
-from tdm.evaluate import evaluate
 
 from .conftest import REPO, render_recording
 
