@@ -236,6 +236,8 @@ class Fuser:
         tracks fill the sensors the older lacks and are absorbed otherwise.
         """
         targets = sorted(self.targets, key=lambda t: (t.created_s, t.target_id))
+        est = {t.target_id: self._estimate(t, states) for t in targets}
+        half = {t.target_id: self._half_length(t, live) for t in targets}
         gone: set[int] = set()
         for i, older in enumerate(targets):
             if older.target_id in gone:
@@ -243,9 +245,9 @@ class Fuser:
             for younger in targets[i + 1:]:
                 if younger.target_id in gone:
                     continue
-                xo, po = self._estimate(older, states)
-                xy, py = self._estimate(younger, states)
-                radius = max(self._half_length(older, live), self._half_length(younger, live))
+                xo, _ = est[older.target_id]
+                xy, py = est[younger.target_id]
+                radius = max(half[older.target_id], half[younger.target_id])
                 if not self._inside((xy, py), xo, radius):
                     continue
                 n_ais = ("ais" in older.members) + ("ais" in younger.members)
@@ -265,6 +267,8 @@ class Fuser:
                 if older.descriptor == "unknown":
                     older.descriptor = younger.descriptor
                 gone.add(younger.target_id)
+                est[older.target_id] = self._estimate(older, states)
+                half[older.target_id] = self._half_length(older, live)
         self.targets = [t for t in self.targets if t.target_id not in gone]
 
     def _split_inconsistent(self, target: FusedTarget, states) -> None:
