@@ -120,10 +120,13 @@ class Revolution:
     target_snr: np.ndarray = field(repr=False, default=None)  # (S, N) float32, object echoes alone (linear, re. noise)
     texture: np.ndarray = field(repr=False, default=None)  # (S, N) float32, clutter texture (mean 1) or None
     clutter: np.ndarray = field(repr=False, default=None)  # (S, N) float32, sea clutter alone (linear, re. noise)
+    object_id: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int32))  # (K,) int32, objects the rays hit
+    object_spokes: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int32))  # (K,) int32, spokes hitting each
 
     def arrays(self) -> dict:
         return {"echo": self.echo, "azimuth_deg": self.azimuth_deg, "heading_deg": self.heading_deg,
-                "time": self.time, "range_m": self.range_m}
+                "time": self.time, "range_m": self.range_m, "object_id": self.object_id,
+                "object_spokes": self.object_spokes}
 
 
 class RadarRenderer:
@@ -247,7 +250,7 @@ class RadarRenderer:
         antenna_h = np.maximum(pos[:, 2], 0.05)
         max_range = self.cfg.range_m * 1.5 + 10.0
         hits, on_carrier = self.scene.cast(o_w, d_w, np.repeat(t, K), o_b, d_b, max_range_m=max_range)
-        targets, first_hit = self._targets(hits, on_carrier, t, o_w, d_w, antenna_h)
+        targets, first_hit, seen = self._targets(hits, on_carrier, t, o_w, d_w, antenna_h)
         clutter, texture = self._sea_clutter(rev, t, rot, pos, azimuth, heading, antenna_h, first_hit)
 
         # ---- receiver: rain clutter, attenuation, thermal noise, STC, FTC, log video, fixed 4-bit levels
@@ -265,17 +268,20 @@ class RadarRenderer:
         echo = phys.quantise(p_db, p.video_floor_db, p.video_step_db)
         echo[:, : self.blank] = 0
         return Revolution(echo, azimuth.astype(np.float32), heading.astype(np.float32), t, self.range_m,
-                          p_db, first_hit, targets, texture, clutter)
+                          p_db, first_hit, targets, texture, clutter, *seen)
 
     def _targets(self, hits, on_carrier, t, o_w, d_w, antenna_h):
-        """(S, N) object echoes (SNR, linear; None if no object is hit) and the first hit range per spoke."""
+        """(S, N) object echoes (SNR, linear; None if no object is hit), the first hit range per spoke, and
+        the objects seen: ((K,) int32 ids of the objects a ray reached, first along it and above the
+        radar horizon; (K,) int32 how many spokes reached each)."""
         S, N, K = self.spokes, self.samples, self.k
         p = self.p
         oid = hits.object_id
         h = np.flatnonzero((oid != NO_HIT) & (oid != SEA_ID) & ~on_carrier)
         first_hit = np.full(S, np.inf)
+        nothing = (np.zeros(0, np.int32), np.zeros(0, np.int32))
         if h.size == 0:
-            return None, first_hit
+            return None, first_hit, nothing
         r_h = hits.range_m[h]
         spoke_h = h // K
         point = o_w[h] + r_h[:, None] * d_w[h]
@@ -284,8 +290,11 @@ class RadarRenderer:
             visible = point[:, 2] >= phys.hidden_height_m(horiz, antenna_h[spoke_h])
             h, r_h, spoke_h, point = h[visible], r_h[visible], spoke_h[visible], point[visible]
             if h.size == 0:
-                return None, first_hit
+                return None, first_hit, nothing
         np.minimum.at(first_hit, spoke_h, r_h)
+        pairs = np.unique(oid[h].astype(np.int64) * S + spoke_h)  # (object, spoke) pairs
+        seen_id, seen_spokes = np.unique(pairs // S, return_counts=True)
+        seen = (seen_id.astype(np.int32), seen_spokes.astype(np.int32))
         el_idx = (h % K) % self.el_rad.size
         normal = hits.normal[h].astype(np.float64)
         cos_ray = -np.einsum("ij,ij->i", normal, d_w[h])
@@ -317,7 +326,7 @@ class RadarRenderer:
         if cols.size:
             sub = np.fft.irfft(np.fft.rfft(targets[:, cols], axis=0) * self.az_kernel_f[:, None], n=S, axis=0)
             targets[:, cols] = np.maximum(sub, 0.0)
-        return targets.astype(np.float32), first_hit
+        return targets.astype(np.float32), first_hit, seen
 
     def _sea_clutter(self, rev, t, rot, pos, azimuth, heading, antenna_h, first_hit):
         """(S, N) sea clutter SNR (K-distributed, zero in shadow and beyond the horizon) and its texture.

@@ -78,6 +78,26 @@ def test_a_berg_behind_a_tall_hull_is_hidden(tmp_path):
     assert peak(hidden_renderer) <= 2
 
 
+def test_sweeps_name_the_objects_the_rays_reach_and_not_those_hidden(tmp_path):
+    berg = {"name": "berg", "kind": "iceberg", "position": latlon(0.0, 1200.0), "radius_m": 15, "height_m": 6}
+    calm = {"sea_state": 0, "wind_speed_mps": 0}
+    open_renderer, _ = radar_world(tmp_path, obstacles=[berg], environment=calm, name="open")
+    hidden_renderer, _ = radar_world(tmp_path, obstacles=[hull(tmp_path, "wall", 0.0, 600.0, length=120.0, height=25.0), berg],
+                                     environment=calm, name="hidden")
+    def ids(renderer):
+        return {o.name: o.object_id for o in renderer.world.objects}
+
+    seen = open_renderer.render_revolution(0)
+    assert seen["object_id"].dtype == np.int32 and seen["object_spokes"].shape == seen["object_id"].shape
+    assert seen["object_id"].tolist() == [ids(open_renderer)["berg"]]
+    # a 30 m berg at 1200 m spans 1.4 deg: 2 spokes of 0.7 deg, more with the beam's elevation rays' spread
+    assert 2 <= int(seen["object_spokes"][0]) <= 6
+    hidden = hidden_renderer.render_revolution(0)
+    assert hidden["object_id"].tolist() == [ids(hidden_renderer)["wall"]]  # the berg is behind the wall: no ray reaches it
+    wall_deg = np.degrees(2 * np.arctan(60.0 / 600.0))
+    assert abs(int(hidden["object_spokes"][0]) - wall_deg / (360.0 / SPOKES)) <= 3
+
+
 def test_sea_clutter_falls_with_range_rises_with_sea_state_and_is_absent_behind_a_hull(tmp_path):
     means = {}
     for state in (2, 5):
