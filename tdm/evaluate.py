@@ -22,7 +22,10 @@ Truth at an epoch
     mesh, ...) is.
 In range (visible)
     At epoch t an object is in range when any rendered sensor could see it: radar:
-    distance from the own ship <= ``sensors.radar.range_m``; LiDAR: hit by at least one
+    distance from the own ship <= ``sensors.radar.range_m`` and, when the sweeps carry
+    ``object_id`` / ``object_spokes``, reached by the rays of at least 3 spokes of a
+    revolution that overlaps t +- 0.5 s (not hidden behind another object or below the
+    radar horizon); LiDAR: hit by at least one
     LiDAR point whose time is within +-0.5 s of t (``object_id`` of the sweeps; if the
     sweeps carry no ``object_id``: distance <= ``sensors.lidar.range_max_m``); AIS: truth
     ``ais`` true and distance <= ``sensors.ais.range_m``. A sensor counts when it is in the
@@ -45,9 +48,12 @@ Errors
     truth SOG > 0.5 m/s). Pairs whose reported value is null are skipped.
 Detection
     ``detection_rate`` = matched (object, epoch) pairs / in-range (object, epoch) pairs.
-    Detection latency of an object = time of its first matched epoch - time of its first
-    in-range epoch; null when it was visible but never matched (it is then in
-    ``missed_objects``). ``detection_latency_max_s`` is over the objects matched at least once.
+    Detection latency of an object = time of its first matched epoch - time it came into
+    view (not less than 0): the first epoch of its first run of consecutive in-range epochs
+    lasting at least 5 s (``MIN_IN_VIEW_S``; the first in-range epoch if none lasts so long);
+    null when it was visible but never matched (it is then in ``missed_objects``). Per
+    object, ``latency_from_first_in_range_s`` counts from the first in-range epoch instead.
+    ``detection_latency_max_s`` is over the objects matched at least once.
 False targets
     A target id is false when it is matched at fewer than half of the epochs it is
     reported at; ``false_targets_per_min`` = number of false ids / (manifest ``duration_s``
@@ -93,6 +99,13 @@ from tdm.metrics import DEFAULT_CUTOFF_M, DEFAULT_ORDER_P, GOSPA_ALPHA, assign_d
 DEFAULT_UPDATE_RATE_HZ = 1.0
 #: Half-width of the window in which a LiDAR hit makes an object visible, s (task definition).
 LIDAR_VISIBLE_WINDOW_S = 0.5
+#: Fewest spokes of a revolution whose rays must reach an object for the radar to see it (0.5 deg at 2048
+#: spokes; a radar plot needs 3 spokes too, docs/tdm.md).
+RADAR_VISIBLE_MIN_SPOKES = 3
+#: Shortest run of in-range epochs that brings an object into view for the latency, s: two radar
+#: revolutions. A glimpse (one revolution's rays between two occlusions) cannot start a track that needs
+#: two plots, so it does not start the latency clock (docs/tdm.md).
+MIN_IN_VIEW_S = 5.0
 #: LiDAR range when the scenario gives none, m (REFERENCE.md section 2: HDL-32E returns to 100 m).
 DEFAULT_LIDAR_RANGE_M = 100.0
 #: Truth SOG above which an object counts as moving for the COG error, m/s (task definition).
@@ -119,7 +132,8 @@ DEFINITIONS = {
               "united with all reported times",
     "truth_at_epoch": "position and SOG linearly interpolated in the 0.1 s truth, COG and AIS flag nearest; "
                       "own ship excluded",
-    "in_range": "radar: distance <= radar range_m; lidar: hit by a LiDAR point within +-0.5 s (object_id); "
+    "in_range": "radar: distance <= radar range_m and, if the sweeps carry object_id, reached on >= 3 spokes "
+                "of a revolution within +-0.5 s; lidar: hit by a LiDAR point within +-0.5 s (object_id); "
                 "ais: truth ais and distance <= ais range_m; any rendered sensor",
     "matching": "per epoch, linear_sum_assignment on min(d, c)^p of targets to in-range truth; pairs with d >= c "
                 "unmatched",
@@ -132,7 +146,9 @@ DEFINITIONS = {
     "cog_rmse_deg": "RMS of wrapped COG difference over matched pairs with truth SOG > 0.5 m/s",
     "sog_rmse_mps": "RMS of SOG difference over matched pairs",
     "detection_rate": "matched (object, epoch) pairs / in-range (object, epoch) pairs",
-    "detection_latency_s": "per object: first matched epoch - first in-range epoch; null when never matched",
+    "detection_latency_s": "per object: first matched epoch - start of the first run of in-range epochs lasting "
+                           ">= 5 s (at least 0; the first in-range epoch if no run is so long); null when never "
+                           "matched",
     "false_targets_per_min": "target ids matched at fewer than half of their reported epochs, per minute of "
                              "manifest duration",
     "false_reports_per_min": "unmatched (target, epoch) reports per minute",
@@ -303,6 +319,39 @@ def _lidar_hit_times(recording: Path) -> dict[int, np.ndarray] | None:
     return {int(u): times_all[bounds[i]:bounds[i + 1]] for i, u in enumerate(uniq)}
 
 
+def _radar_seen_intervals(recording: Path) -> dict[int, tuple[np.ndarray, np.ndarray]] | None:
+    """Revolutions in which the radar's rays reached each truth object: {id: ((R,) start s, (R,) end s)}.
+
+    An object counts as reached on at least :data:`RADAR_VISIBLE_MIN_SPOKES` spokes of the revolution
+    (its ``object_id`` / ``object_spokes``). None when the sweeps carry no ``object_id``.
+    """
+    files = sorted((Path(recording) / "radar" / "sweeps").glob("*.npz"))
+    if not files:
+        return None
+    seen: dict[int, list[tuple[float, float]]] = {}
+    for file in files:  # loop over sweeps, a few ids each
+        try:
+            with np.load(file) as z:
+                if "object_id" not in z.files or "object_spokes" not in z.files or "time" not in z.files:
+                    return None
+                ids, spokes, t = z["object_id"], z["object_spokes"], z["time"]
+        except (OSError, ValueError, KeyError) as exc:
+            raise RecordingError(str(file), "(file)", f"not a readable NPZ: {exc}") from None
+        if t.size == 0:
+            continue
+        for object_id in ids[spokes >= RADAR_VISIBLE_MIN_SPOKES]:
+            seen.setdefault(int(object_id), []).append((float(t[0]), float(t[-1])))
+    return {k: (np.array([a for a, _ in v]), np.array([b for _, b in v])) for k, v in seen.items()}
+
+
+def _overlaps(starts: np.ndarray, ends: np.ndarray, t_s: np.ndarray, half_window_s: float) -> np.ndarray:
+    """(E,) bool: some interval [start, end] (sorted, disjoint) meets [t - w, t + w]."""
+    if starts.size == 0:
+        return np.zeros(t_s.shape, dtype=bool)
+    idx = np.searchsorted(ends, t_s - half_window_s, side="left")
+    return (idx < ends.size) & (starts[np.minimum(idx, ends.size - 1)] <= t_s + half_window_s)
+
+
 # ----------------------------------------------------------------------------------------------- truth at epochs
 
 
@@ -450,9 +499,17 @@ def _visibility(recording: Path, scenario: dict, manifest: dict, truth: TruthAtE
     ais_range_m = _range_param(recording, scenario, "ais", "range_m", math.inf)
     lidar_range_m = _range_param(recording, scenario, "lidar", "range_max_m", DEFAULT_LIDAR_RANGE_M)
     visible = {}
-    lidar_mode = None
+    lidar_mode = radar_mode = None
     if "radar" in rendered:
         visible["radar"] = rng <= radar_range_m
+        seen = _radar_seen_intervals(recording)
+        radar_mode = "range" if seen is None else "rays"
+        if seen is not None:
+            mask = np.zeros(rng.shape, dtype=bool)
+            for k, object_id in enumerate(truth.ids):  # loop over objects
+                if int(object_id) in seen:
+                    mask[:, k] = _overlaps(*seen[int(object_id)], truth.t_s, LIDAR_VISIBLE_WINDOW_S)
+            visible["radar"] &= mask
     if "ais" in rendered:
         visible["ais"] = truth.ais & (rng <= ais_range_m)
     if "lidar" in rendered:
@@ -465,17 +522,28 @@ def _visibility(recording: Path, scenario: dict, manifest: dict, truth: TruthAtE
             mask = np.zeros(rng.shape, dtype=bool)
             for k, object_id in enumerate(truth.ids):  # loop over objects
                 h = hits.get(int(object_id))
-                if h is None or h.size == 0:
-                    continue
-                idx = np.searchsorted(h, truth.t_s - LIDAR_VISIBLE_WINDOW_S, side="left")
-                mask[:, k] = (idx < h.size) & (h[np.minimum(idx, h.size - 1)] <= truth.t_s + LIDAR_VISIBLE_WINDOW_S)
+                if h is not None:
+                    mask[:, k] = _overlaps(h, h, truth.t_s, LIDAR_VISIBLE_WINDOW_S)
             visible["lidar"] = mask & present
     params = {"sensors_rendered": rendered, "radar_range_m": radar_range_m, "ais_range_m": ais_range_m,
-              "lidar_range_max_m": lidar_range_m, "lidar_visibility": lidar_mode}
+              "lidar_range_max_m": lidar_range_m, "lidar_visibility": lidar_mode, "radar_visibility": radar_mode}
     return visible, params
 
 
 # ----------------------------------------------------------------------------------------------- scoring
+
+
+def _sustained_start(vis_e: np.ndarray, t_s: np.ndarray) -> int:
+    """Epoch at which an object comes into view: the first epoch of the first run of consecutive in-range
+    epochs lasting at least :data:`MIN_IN_VIEW_S`; the first in-range epoch when no run lasts so long.
+
+    ``vis_e`` are the object's in-range epoch indices, ascending; ``t_s`` the epoch times.
+    """
+    brk = np.flatnonzero(np.diff(vis_e) != 1)
+    starts = vis_e[np.r_[0, brk + 1]]
+    ends = vis_e[np.r_[brk, vis_e.size - 1]]
+    long_enough = np.flatnonzero(t_s[ends] - t_s[starts] >= MIN_IN_VIEW_S)
+    return int(starts[long_enough[0]]) if long_enough.size else int(vis_e[0])
 
 
 def _rms(x: np.ndarray) -> float:
@@ -556,7 +624,9 @@ def _score(truth: TruthAtEpochs, visible: np.ndarray, reports: dict[str, np.ndar
         if vis_e.size == 0:
             continue
         m_e = np.flatnonzero(matched_tid[:, k] >= 0)
-        lat_s = float(t_s[m_e[0]] - t_s[vis_e[0]]) if m_e.size else None
+        start_e = _sustained_start(vis_e, t_s)
+        lat_s = max(float(t_s[m_e[0]] - t_s[start_e]), 0.0) if m_e.size else None
+        glimpse_lat_s = float(t_s[m_e[0]] - t_s[vis_e[0]]) if m_e.size else None
         switches = int(np.count_nonzero(np.diff(matched_tid[m_e, k]))) if m_e.size else 0
         switches_total += switches
         switches_max = max(switches_max, switches)
@@ -565,7 +635,8 @@ def _score(truth: TruthAtEpochs, visible: np.ndarray, reports: dict[str, np.ndar
         if lat_s is None:
             missed.append(name)
         per_object.append({"id": int(truth.ids[k]), "name": truth.names[k], "kind": truth.kinds[k],
-                           "first_in_range_s": float(t_s[vis_e[0]]), "epochs_in_range": int(vis_e.size),
+                           "first_in_range_s": float(t_s[vis_e[0]]), "in_view_from_s": float(t_s[start_e]),
+                           "epochs_in_range": int(vis_e.size), "latency_from_first_in_range_s": glimpse_lat_s,
                            "epochs_matched": int(m_e.size), "matched_fraction": m_e.size / vis_e.size,
                            "latency_s": lat_s, "id_switches": switches,
                            "target_ids": sorted({int(x) for x in matched_tid[m_e, k]}),

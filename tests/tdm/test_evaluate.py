@@ -12,7 +12,7 @@ import pytest
 import yaml
 
 from tdm.errors import RecordingError
-from tdm.evaluate import evaluate, format_table, write_metrics
+from tdm.evaluate import _sustained_start, evaluate, format_table, write_metrics
 from tdm.frames import EnuFrame
 from tdm.plots import plot_errors, plot_tracks
 
@@ -318,3 +318,12 @@ def test_perfect_targets_on_a_rendered_recording(bos_recording, tmp_path):
     assert m["detection_latency_max_s"] == 0.0
     n_objects = len({r["id"] for r in truth if r["kind"] != "ownship"})
     assert m["objects_in_range"] == n_objects  # the radar's 1852 m holds the whole scene
+
+
+def test_a_glimpse_does_not_start_the_latency_clock():
+    t_s = np.arange(30.0)
+    # in range at 2-3 s (a glimpse between occlusions), then 6-8 s (3 s: still too short), then from 12 s on
+    vis_e = np.r_[2, 3, 6, 7, 8, np.arange(12, 30)]
+    assert _sustained_start(vis_e, t_s) == 12
+    assert _sustained_start(np.arange(0, 6), t_s) == 0  # 0..5 s: a 5 s run counts from its start
+    assert _sustained_start(np.r_[4, 5, 9], t_s) == 4  # never in view 5 s: the first in-range epoch
