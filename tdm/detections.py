@@ -40,6 +40,10 @@ class Detections:
         Points (LiDAR) or range-azimuth cells (radar) in the detection.
     range_m : (N,) float64
         Distance from the sensor, metres.
+    strength_db : (N,) float64 or None
+        How far each detection stands out of its background, dB: for a radar plot, its peak
+        beam-integrated power over the local clutter level (:func:`tdm.frontend.radar.clutter_map`).
+        None when the front end has no such measure (LiDAR).
     """
 
     sensor: str
@@ -54,6 +58,7 @@ class Detections:
     height_m: np.ndarray
     n_cells: np.ndarray
     range_m: np.ndarray
+    strength_db: np.ndarray | None = None
 
     def __len__(self) -> int:
         return int(self.time_s.shape[0])

@@ -67,7 +67,10 @@ class TdmConfig:
         # a radar track's second plot is looked for within 4 m/s (8 kn) of standing still, at most
         # 15 m/s (29 kn): sea-clutter pairs far apart no longer start tracks (busy_open_sea, 300 s:
         # 4.2 -> 3.2 false targets a minute)
-        init_speed_sigma_mps=4.0, max_speed_mps=15.0))
+        init_speed_sigma_mps=4.0, max_speed_mps=15.0,
+        # plots barely over the clutter count half a hit, plots well over it 1.5 (TrackerConfig; busy_open_sea,
+        # 300 s: 3.2 -> 0.8 false targets a minute, and strong new objects confirm a scan sooner)
+        weak_below_db=13.0, strong_from_db=15.0))
     ais_tracker: AisTrackerConfig = field(default_factory=AisTrackerConfig)
     fusion_config: FusionConfig = field(default_factory=FusionConfig)
 

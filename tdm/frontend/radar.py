@@ -792,14 +792,18 @@ def _plot_cells(echo: np.ndarray, range_m: np.ndarray, config: RadarFrontEndConf
 
 
 def _stands_out(lab: np.ndarray, spoke: np.ndarray, sample: np.ndarray, n_labels: int, eligible: np.ndarray,
-                integrated: np.ndarray, g: int, config: RadarFrontEndConfig) -> np.ndarray:
-    """(n_labels,) bool: eligible plots whose peak beam-integrated power reaches their clutter-map threshold.
+                integrated: np.ndarray, g: int, config: RadarFrontEndConfig) -> tuple[np.ndarray, np.ndarray]:
+    """Eligible plots whose peak beam-integrated power reaches their clutter-map threshold.
+
+    Returns ``keep`` (n_labels,) bool and ``margin_db`` (n_labels,) float32: each plot's peak over
+    its clutter level, dB (-inf where not worked out).
 
     A cell of spoke group k lies in integration windows k - 1 and k and takes the larger; a plot's
     peak is its largest, and the clutter level is worked out for the peak's block only
     (:func:`clutter_map` gives the same threshold for every block).
     """
     out = np.zeros(n_labels, dtype=bool)
+    margin_db = np.full(n_labels, -np.inf, dtype=np.float32)
     a = integrated.shape[0]
     k = spoke // g
     before, here = integrated[(k - 1) % a, sample], integrated[k, sample]
@@ -807,7 +811,7 @@ def _stands_out(lab: np.ndarray, spoke: np.ndarray, sample: np.ndarray, n_labels
     # only cells above the lowest seed threshold can be a kept plot's peak
     cells = np.flatnonzero((value >= np.float32(10.0 ** (config.min_seed_db / 10.0))) & eligible[lab])
     if cells.size == 0:
-        return out
+        return out, margin_db
     value, lab_c = value[cells], lab[cells]
     row = np.where(before[cells] > here[cells], (k[cells] - 1) % a, k[cells])
     peak = np.full(n_labels, -np.inf, dtype=np.float32)
@@ -819,8 +823,9 @@ def _stands_out(lab: np.ndarray, spoke: np.ndarray, sample: np.ndarray, n_labels
     block_db, ba = _block_max_db(integrated, g, config)
     level_db = _clutter_level_db(block_db, row[peak_cell] // ba,
                                  sample[cells[peak_cell]] // config.clutter_block_samples, config)
-    out[labels] = peak_db >= level_db + config.clutter_margin_db
-    return out
+    margin_db[labels] = peak_db - level_db
+    out[labels] = margin_db[labels] >= config.clutter_margin_db
+    return out, margin_db
 
 
 def radar_detections(sweep: dict, track: OwnshipTrack, mount: Mount, config: RadarFrontEndConfig) -> Detections:
@@ -893,9 +898,11 @@ def radar_detections(sweep: dict, track: OwnshipTrack, mount: Mount, config: Rad
     n_spk = _spokes_per_label(lab, spoke, n + 1, n_spokes)
     keep = (n_cells >= config.min_plot_cells) & (n_cells <= config.max_plot_cells) & (n_spk >= config.min_plot_spokes)
     keep[0] = False
-    keep &= _stands_out(lab, spoke, sample, n + 1, keep, integrated, g, config)
+    stands_out, margin_db = _stands_out(lab, spoke, sample, n + 1, keep, integrated, g, config)
+    keep &= stands_out
     if not keep.any():
         return Detections.empty("radar", scan_time)
+    margin_db = margin_db[np.flatnonzero(keep)].astype(np.float64)
     sel = keep[lab]
     spoke, sample, lab = spoke[sel], sample[sel], lab[sel]
     _, lab = np.unique(lab, return_inverse=True)  # 0..m-1
@@ -967,6 +974,7 @@ def radar_detections(sweep: dict, track: OwnshipTrack, mount: Mount, config: Rad
         height_m=np.full(int(np.count_nonzero(k)), np.nan),
         n_cells=np.bincount(lab, minlength=m).astype(np.int64)[k],
         range_m=rng[k],
+        strength_db=margin_db[k],
     )
 
 

@@ -224,6 +224,9 @@ def test_a_weak_target_stands_out_of_a_quiet_sea_but_not_out_of_equally_strong_c
     target = (600, 30, 500, 4, 5)  # level 5 over 30 spokes: 23 dB integrated
     quiet = radar_detections(sweep_with([target]), static_track(), Mount(), config)
     assert len(quiet) == 1
+    # its strength: the peak integrated power over a quiet sea's floor (the noise mean, 0 dB): level 5
+    # is 9.6 + 3 x 4.5 = 23.1 dB; over 4 samples of 30 spokes the 8-spoke window holds it whole
+    assert quiet.strength_db[0] == pytest.approx(23.1, abs=0.1)
     # the same echo among many like it (a clutter field of level-5 patches around it) is not a plot
     field = [(s, 30, c, 4, 5) for s in range(0, SPOKES, 64) for c in range(440, 580, 20)]
     busy = radar_detections(sweep_with(field), static_track(), Mount(), config)

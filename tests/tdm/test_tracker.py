@@ -68,6 +68,28 @@ def test_tracks_are_deleted_after_coasting_and_clutter_is_never_confirmed():
     assert tracker.confirmed_tracks() == []  # the object left 10 s ago (> coast 5 s); clutter never confirmed
 
 
+def test_strong_plots_confirm_in_two_scans_and_marginal_ones_need_more():
+    cfg = TrackerConfig(confirm_m=3, confirm_n=4, coast_s=10.0, position_floor_m2=0.0, max_range_m=1e4,
+                        weak_below_db=13.0, strong_from_db=16.0)
+
+    def confirmed_after(strength_db, scans):
+        tracker = PositionTracker("radar", cfg)
+        for k in range(scans):
+            d = scan(2.5 * k, [[600.0, 0.0]])
+            d.strength_db = np.array([strength_db])
+            tracker.process(d, np.zeros(2))
+        return bool(tracker.confirmed_tracks())
+
+    assert confirmed_after(20.0, 2) and not confirmed_after(20.0, 1)  # 1.5 + 1.5
+    assert confirmed_after(14.0, 3) and not confirmed_after(14.0, 2)  # 1 + 1 + 1
+    assert not confirmed_after(11.0, 4)  # 4 x 0.5: barely over the clutter, never in 4 scans
+    assert confirmed_after(11.0, 6) is False  # nor later: only the last 4 scans count
+    plain = PositionTracker("radar", TrackerConfig(confirm_m=3, confirm_n=4, max_range_m=1e4))
+    for k in range(3):  # without strengths (LiDAR) every hit counts 1
+        plain.process(scan(float(k), [[600.0, 0.0]]), np.zeros(2))
+    assert plain.confirmed_tracks()
+
+
 def test_misses_outside_the_sensor_range_do_not_count():
     cfg = TrackerConfig(confirm_m=3, confirm_n=5, coast_s=100.0, position_floor_m2=0.0, max_range_m=100.0)
     tracker = PositionTracker("lidar", cfg)
