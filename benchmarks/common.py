@@ -74,7 +74,8 @@ def ensure_recording(scenario: Path, out: Path, duration_s: float, fresh: bool =
     """Render ``scenario`` for ``duration_s`` into ``out`` unless a matching render is there.
 
     Returns the recording and the render's wall time (None when reused). A render is reused when
-    its manifest says the same scenario name and duration and it is newer than the scenario file.
+    its manifest says the same scenario name and duration and it is newer than the scenario file and
+    than every source file of the renderer (``raysim/``).
     """
     import shutil
 
@@ -85,7 +86,7 @@ def ensure_recording(scenario: Path, out: Path, duration_s: float, fresh: bool =
         m = json.loads(manifest.read_text(encoding="utf-8"))
         name = yaml.safe_load(scenario.read_text(encoding="utf-8")).get("name")
         if (m.get("scenario") == name and abs(float(m.get("duration_s", -1)) - duration_s) < 1e-6
-                and manifest.stat().st_mtime > scenario.stat().st_mtime):
+                and manifest.stat().st_mtime > max(p.stat().st_mtime for p in [scenario, *(ROOT / "raysim").rglob("*.py")])):
             return out, None
     if out.exists():
         shutil.rmtree(out)

@@ -192,7 +192,7 @@ def cmd_import_hilsim(args) -> int:
     return 0
 
 
-BENCHMARKS = ("ray_engine", "lidar", "radar", "rosbag", "tdm_speed")
+BENCHMARKS = ("ray_engine", "lidar", "radar", "rosbag", "tdm_speed", "tdm_criteria")
 
 
 def cmd_bench(args) -> int:

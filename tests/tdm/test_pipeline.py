@@ -79,23 +79,11 @@ def test_crossing_with_a_silent_ship_meets_the_done_criteria(crossing):
     assert metrics["classification_accuracy"] >= 0.5
 
 
-def test_busy_open_sea_meets_the_accuracy_and_false_target_criteria(busy):
+def test_busy_open_sea_meets_the_done_criteria(busy):
     _, metrics = busy
-    check_done_when(metrics, latency_limit_s=30.0, false_per_min=2.0)
-
-
-@pytest.mark.xfail(strict=True, reason="weak icebergs at 550-700 m in sea state 4 and bergs whose radar echoes "
-                   "merge with a neighbour's take 13-25 s to confirm (docs/tdm.md, known limits)")
-def test_busy_open_sea_reports_every_object_within_10_s(busy):
-    _, metrics = busy
-    assert metrics["detection_latency_max_s"] <= 10.0
-
-
-@pytest.mark.xfail(strict=True, reason="sea-state-4 clutter at 600-1000 m forms 1-3 radar-only false targets "
-                   "per minute (docs/tdm.md, known limits)")
-def test_busy_open_sea_has_at_most_one_false_target_per_minute(busy):
-    _, metrics = busy
-    assert metrics["false_targets_per_min"] <= 1.0
+    check_done_when(metrics)
+    # the clock starts when an object comes into view: radar occlusion behind a nearer berg is ray truth
+    assert metrics["parameters"]["radar_visibility"] == "rays"
 
 
 def test_fusion_beats_the_single_sensors_where_they_overlap(busy):
