@@ -62,6 +62,25 @@ def _formats(text: str) -> tuple[str, ...]:
     return names
 
 
+def _count(option: str):
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise InputError("command line", option, f"not an integer: {text!r}") from None
+        if value < 1:
+            raise InputError("command line", option, f"must be >= 1, got {value}")
+        return value
+
+    return parse
+
+
+def _vary(text: str):
+    from raysim.batch import parse_vary
+
+    return parse_vary(text)
+
+
 def _route(text: str) -> list[list[float]]:
     points = []
     for part in text.split(";"):
@@ -101,6 +120,18 @@ def build_parser() -> argparse.ArgumentParser:
     imp.add_argument("--route", type=_route, help="own-ship waypoints 'lat,lon;lat,lon;...' (default: lie still at the start)")
     imp.add_argument("--speed-kn", type=float, default=8.0, help="own-ship speed on the route, knots")
     imp.add_argument("--duration", type=_duration, default=300.0, help="scenario duration, s")
+
+    batch = sub.add_parser("batch", help="render, run and evaluate many seeds and variants on Dask (docs/batch.md)")
+    batch.add_argument("scenario", type=Path, help="scenario YAML file")
+    batch.add_argument("-o", "--out", type=Path, required=True, help="batch directory (runs/, results/, summary.csv)")
+    batch.add_argument("--seeds", type=_count("--seeds"), default=1, help="runs per variant, seeds base .. base + N - 1")
+    batch.add_argument("--seed", type=_seed, help="first seed (default: the scenario's)")
+    batch.add_argument("--vary", type=_vary, action="append", default=[], metavar="KEY=V1,V2,...",
+                       help="a scenario key path and its values; repeat for more keys (all combinations run)")
+    batch.add_argument("--duration", type=_duration, help="override duration_s")
+    batch.add_argument("--scheduler", help="address of a Dask scheduler (default: a local cluster)")
+    batch.add_argument("--workers", type=_count("--workers"), help="local cluster worker processes (default: one per core)")
+    batch.add_argument("--no-progress", action="store_true", help="no progress lines")
 
     bench = sub.add_parser("bench", help="run the benchmarks and print their tables")
     bench.add_argument("--quick", action="store_true", help="fewer rays and repetitions")
@@ -158,6 +189,21 @@ def cmd_run(args) -> int:
     return 0
 
 
+def cmd_batch(args) -> int:
+    """Monte-Carlo batch: every (variant, seed) rendered, run and evaluated on Dask; DIR/summary.csv."""
+    from raysim.batch import plan_batch, progress_printer, run_batch
+
+    runs = plan_batch(args.scenario, seeds=args.seeds, vary=args.vary, duration_s=args.duration, base_seed=args.seed)
+    rows = run_batch(runs, args.out, scheduler=args.scheduler, workers=args.workers,
+                     progress=progress_printer(not args.no_progress))
+    failed = [r for r in rows if r["status"] != "ok"]
+    print(f"batch of {len(rows)} runs in {args.out}: {len(rows) - len(failed)} ok, {len(failed)} failed; "
+          f"summary in {args.out / 'summary.csv'}")
+    for row in failed:
+        print(f"  failed: {row['run']}: {row['error']}")
+    return 1 if failed else 0
+
+
 def _summary(result) -> None:
     m = result.manifest
     counts = ", ".join(f"{k}: {v}" for k, v in m["counts"].items())
@@ -192,7 +238,7 @@ def cmd_import_hilsim(args) -> int:
     return 0
 
 
-BENCHMARKS = ("ray_engine", "lidar", "radar", "rosbag", "tdm_speed", "tdm_criteria")
+BENCHMARKS = ("ray_engine", "lidar", "radar", "rosbag", "tdm_speed", "tdm_criteria", "batch_throughput")
 
 
 def cmd_bench(args) -> int:
@@ -231,7 +277,8 @@ def cmd_bench(args) -> int:
     return 0
 
 
-COMMANDS = {"render": cmd_render, "run": cmd_run, "import-hilsim": cmd_import_hilsim, "bench": cmd_bench}
+COMMANDS = {"render": cmd_render, "run": cmd_run, "batch": cmd_batch, "import-hilsim": cmd_import_hilsim,
+            "bench": cmd_bench}
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -395,8 +395,18 @@ def read_yaml(path: Path) -> object:
         raise InputError(str(path), "(file)", f"not valid YAML: {exc}") from None
 
 
-def load_scenario(path: str | Path, resolve_defaults: bool = True) -> Scenario:
+def load_scenario(path: str | Path, resolve_defaults: bool = True, changes: dict[str, object] | None = None) -> Scenario:
     """Load, validate and (by default) resolve a scenario file.
+
+    Parameters
+    ----------
+    path : str or Path
+    resolve_defaults : bool
+        Fill in every default (:func:`resolve`).
+    changes : dict, optional
+        Values to set before validation, by dotted key path (``environment.sea_state``;
+        a number picks a list item: ``ships.0.speed_kn``); missing mappings on the way are
+        created. ``raysim batch --vary`` uses this; the result is validated like the file.
 
     Raises
     ------
@@ -409,6 +419,8 @@ def load_scenario(path: str | Path, resolve_defaults: bool = True) -> Scenario:
         raise InputError(str(path), "(file)", "file holds no scenario (only comments?)")
     if not isinstance(data, dict):
         raise InputError(str(path), "(top level)", "must be a mapping of keys (name, duration_s, own_ship, ...)")
+    for key, value in (changes or {}).items():
+        set_key_path(data, key, value, str(path))
     ctx = Context(path)
     if "name" not in data:
         data = {"name": path.stem, **data}
@@ -416,6 +428,42 @@ def load_scenario(path: str | Path, resolve_defaults: bool = True) -> Scenario:
     object.__setattr__(scenario, "source_file", str(path))
     _validate(scenario, ctx)
     return resolve(scenario) if resolve_defaults else scenario
+
+
+def set_key_path(data: dict, key_path: str, value: object, file: str = "(scenario)") -> None:
+    """Set ``value`` at the dotted ``key_path`` of parsed scenario YAML (in place).
+
+    Mappings missing on the way are created; a number indexes a list. Whether the key exists in
+    the scenario format is checked when the result is validated (unknown keys are errors there).
+
+    Raises
+    ------
+    InputError
+        When the path runs into a value that is neither a mapping nor a list, or past a list's end.
+    """
+    parts = key_path.split(".")
+    if not key_path or any(not p for p in parts):
+        raise InputError(file, key_path or "(key)", "not a dotted key path (like environment.sea_state)")
+    node: object = data
+    for depth, part in enumerate(parts):
+        where = ".".join(parts[: depth + 1])
+        last = depth == len(parts) - 1
+        if isinstance(node, list):
+            if not part.isdigit() or int(part) >= len(node):
+                raise InputError(file, where, f"not an item of the list ({len(node)} items, numbered from 0)")
+            if last:
+                node[int(part)] = value
+            else:
+                node = node[int(part)]
+        elif isinstance(node, dict):
+            if last:
+                node[part] = value
+            else:
+                if node.get(part) is None:
+                    node[part] = {}
+                node = node[part]
+        else:
+            raise InputError(file, ".".join(parts[:depth]), "holds a single value, not keys to set below it")
 
 
 def _validate(s: Scenario, ctx: Context) -> None:
