@@ -16,7 +16,7 @@ by default (one single-threaded worker process per core, no dashboard), or the s
 takes two runs for one. A run that raises is recorded as failed and the batch goes on; a run
 whose worker dies is recorded the same way. Re-running a batch skips the runs whose result is
 ``ok``, whose recording is there and whose scenario (the resolved YAML, hashed) is unchanged;
-failed runs are tried again.
+failed runs are tried again, and what an interrupted batch left half-written of them is removed.
 """
 
 from __future__ import annotations
@@ -30,6 +30,7 @@ import json
 import logging
 import os
 import re
+import shutil
 import sys
 import time
 import traceback
@@ -298,6 +299,10 @@ def run_batch(runs: list[RunSpec], batch_dir: Path, scheduler: str | None = None
         say(f"batch: {len(runs)} runs, {len(runs) - len(todo)} finished before (skipped), {where}")
         if todo:
             from distributed import as_completed
+
+            for spec in todo:  # what an interrupted earlier batch left half-written
+                for stale in (batch_dir / "runs").glob(f".{spec.name}.partial-*"):
+                    shutil.rmtree(stale, ignore_errors=True)
 
             futures = {client.submit(execute_run, spec, str(batch_dir.resolve()), pure=False,
                                      key=f"raysim-run-{spec.name}-{os.urandom(4).hex()}"): spec for spec in todo}

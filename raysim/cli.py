@@ -194,8 +194,12 @@ def cmd_batch(args) -> int:
     from raysim.batch import plan_batch, progress_printer, run_batch
 
     runs = plan_batch(args.scenario, seeds=args.seeds, vary=args.vary, duration_s=args.duration, base_seed=args.seed)
-    rows = run_batch(runs, args.out, scheduler=args.scheduler, workers=args.workers,
-                     progress=progress_printer(not args.no_progress))
+    try:
+        rows = run_batch(runs, args.out, scheduler=args.scheduler, workers=args.workers,
+                         progress=progress_printer(not args.no_progress))
+    except KeyboardInterrupt:
+        print("error: interrupted; the finished runs are kept: the same command goes on from there", file=sys.stderr)
+        return 130
     failed = [r for r in rows if r["status"] != "ok"]
     print(f"batch of {len(rows)} runs in {args.out}: {len(rows) - len(failed)} ok, {len(failed)} failed; "
           f"summary in {args.out / 'summary.csv'}")

@@ -118,8 +118,12 @@ def test_a_failing_variant_is_recorded_and_the_batch_goes_on(tmp_path, capsys):
         assert (out / "runs" / rows["buoy.stl"]["run"] / "manifest.json").is_file()
         captured = capsys.readouterr()
         assert f"failed: {failed['run']}" in captured.out
-        # again: the finished run is skipped, the failed one tried again (and fails again)
+        # again: the finished run is skipped, the failed one tried again (and fails again); what an
+        # interrupted batch left half-written of it goes
+        stale = out / "runs" / f".{failed['run']}.partial-99999"
+        (stale / "lidar").mkdir(parents=True)
         assert main(argv) == 1
+        assert not stale.exists()
         assert "1 finished before (skipped), 1 to run" in capsys.readouterr().err
     assert [r["status"] for r in summary(out)] == ["ok", "failed"]
 
