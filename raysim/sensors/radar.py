@@ -51,6 +51,8 @@ from raysim.sensors.lidar import mount_transform
 
 #: mean of 10 log10 of exponential noise power of mean 1: -10 gamma / ln 10 (Euler's gamma), dB
 NOISE_LOG_MEAN_DB = -2.507
+#: Largest sea-clutter mean SNR, dB: far above video level 15 (about 55 dB) and far below float32's 385 dB.
+MAX_CLUTTER_DB = 200.0
 
 
 @dataclass(frozen=True)
@@ -366,6 +368,11 @@ class RadarRenderer:
         el_sq = sin_el * sin_el
         el_sq[:, :steep] = np.arcsin(np.clip(sin_el[:, :steep], -1.0, 1.0)) ** 2
         mean_db += np.float32(2.0 * phys.one_way_gain_db(math.degrees(1.0), p.beam_el_deg)) * el_sq
+        # no sea is nearer than the antenna is high: there the grazing geometry has no solution and the table runs
+        # away (278 dB at the antenna, 150 dB jumps per 0.1 m of height, overflowing float32 with the heave's slope;
+        # an inf poisons the FTC filter down the whole spoke); the cap keeps the rest of float32 finite
+        mean_db[:, self.range_m <= float(np.max(antenna_h))] = -np.inf
+        np.minimum(mean_db, np.float32(MAX_CLUTTER_DB), out=mean_db)
         mean = np.power(np.float32(10.0), mean_db * np.float32(0.1))
         texture = None
         if self.env.sea_state > 0:

@@ -430,6 +430,33 @@ def test_main_bang_blanking_zeroes_the_first_samples(tmp_path):
             assert e[:, near][:, 1:].max() > 0
 
 
+def test_no_sea_clutter_nearer_than_the_antenna_height_and_none_overflows_on_a_heaving_ship(tmp_path):
+    """Samples nearer than the antenna is high hold no sea. They once held the radar equation's runaway (about
+    280 dB), which the heave's slope overflowed; with rain control (FTC) on an inf ran down the whole spoke."""
+    import warnings
+
+    from raysim.sensors.radar import RadarParams
+
+    data = scenario(tmp_path, environment={"sea_state": 4, "wind_speed_mps": 10}, duration=5.0,
+                    own={"position": latlon(0, 0), "heading_deg": 0,
+                         "motion": {"roll_amplitude_deg": 3, "pitch_amplitude_deg": 2, "heave_amplitude_m": 0.5}})
+    data["sensors"] = {"lidar": {"enabled": False},
+                       "radar": {"spokes": SPOKES, "samples": SAMPLES, "range_m": 463.0, "mount": {"z_m": 12.0}}}
+    path = tmp_path / "heave.yaml"
+    path.write_text(yaml.safe_dump(data))
+    world = World(load_scenario(path))
+    assert world.own_ship.motion.poses(np.linspace(0.0, 2.5, 9)).position_m[:, 2].std() > 0.05  # the ship heaves
+    r = RadarRenderer(world, CarrierScene(world.scene_objects(), sea_material=material_index("sea")),
+                      RadarParams(blanking_m=0.0, ftc_m=50.0))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no overflow anywhere
+        revolution = r.revolution(0)
+    assert np.isfinite(revolution.snr_db).all()
+    assert revolution.clutter[:, r.range_m < 11.0].max() == 0.0  # the antenna is 12 m up (+- heave)
+    assert revolution.clutter[:, r.range_m > 20.0].max() > 1.0  # the sea beyond it echoes
+    assert (revolution.echo[:, r.range_m > 100.0] > 0).any()
+
+
 def test_scenario_keys_set_the_radar_model(tmp_path):
     data = scenario(tmp_path, duration=3.0)
     data["sensors"] = {"lidar": {"enabled": False},
