@@ -19,6 +19,10 @@ Usage::
   (``Detections.strength_db``, dB over the local clutter level) percentiles and the fractions
   under 13 dB and from 15 dB: the weights of the radar tracker's confirmation
   (``TdmConfig.radar_tracker``: weak_below_db, strong_from_db).
+- ``--batch DIR``: also tabulates the criteria of every run of a ``raysim batch`` of
+  busy_open_sea over other seeds (made beforehand, for example
+  ``raysim batch scenarios/busy_open_sea.yaml --seeds 5 -o DIR``: seeds 7-11, the scenario's
+  own first), from each run's ``tdm/metrics.json``.
 """
 
 from __future__ import annotations
@@ -148,12 +152,39 @@ def report(results: dict, strengths: dict, durations: dict, quick: bool = False)
     return "\n".join(lines) + "\n"
 
 
+def seeds_report(batch: Path) -> str:
+    """The criteria of every run of a ``raysim batch`` (its summary.csv and each run's metrics.json)."""
+    import csv
+
+    with open(batch / "summary.csv", newline="", encoding="utf-8") as f:
+        rows = list(csv.DictReader(f))
+    lines = ["", f"## busy_open_sea over seeds (`raysim batch`, {len(rows)} runs)", "",
+             "The criteria of each run; the objects behind a latency over 10 s and an object with more than one",
+             "id switch are named.", "",
+             "| seed | duration [s] | " + " | ".join(label for _, label, *_ in CRITERIA) + " | slow objects | switching objects |",
+             "|---:|---:|" + "---:|" * len(CRITERIA) + "---|---|"]
+    for row in rows:
+        if row["status"] != "ok":
+            lines.append(f"| {row['seed']} | {row['duration_s']} | failed: {row['error']} |")
+            continue
+        metrics = json.loads((batch / "runs" / row["run"] / "tdm" / "metrics.json").read_text(encoding="utf-8"))
+        values = criteria(metrics)
+        cells = [_fmt(values[key], decimals) + ("" if values[key] is not None and values[key] <= limit else " (not met)")
+                 for key, _, limit, decimals in CRITERIA]
+        slow = ", ".join(f"{o['name']} {o['latency_s']:.0f} s" for o in metrics["per_object"] if (o["latency_s"] or 0) > 10)
+        switching = ", ".join(f"{o['name']} {o['id_switches']}" for o in metrics["per_object"] if o["id_switches"] > 1)
+        lines.append(f"| {row['seed']} | {float(row['duration_s']):.0f} | " + " | ".join(cells)
+                     + f" | {slow or '-'} | {switching or '-'} |")
+    return "\n".join(lines) + "\n"
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--fresh", action="store_true", help="render again even if a matching render exists")
     parser.add_argument("--quick", action="store_true", help="busy_open_sea for 90 s only")
     parser.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results" / "tdm_criteria.md")
     parser.add_argument("--json", type=Path, help="also write the figures as JSON")
+    parser.add_argument("--batch", type=Path, help="a raysim batch of busy_open_sea over seeds to tabulate as well")
     args = parser.parse_args(argv)
     results, recordings, durations = {}, {}, {}
     for name, (scenario, duration_s, directory) in SCENARIOS.items():
@@ -164,6 +195,8 @@ def main(argv=None) -> int:
         results[name] = criteria(run_and_evaluate(recordings[name]))
     strengths = plot_strengths(recordings["busy_open_sea"])
     text = report(results, strengths, durations, args.quick)
+    if args.batch:
+        text += seeds_report(args.batch)
     print(text)
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(text, encoding="utf-8")

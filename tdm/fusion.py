@@ -41,6 +41,10 @@ from tdm.association import chi2_gate, gnn, mahalanobis2
 from tdm.tracker import Track
 
 
+#: Classes of targets that do not move: an ended one is looked for where it was for ``revive_still_s``.
+STILL_DESCRIPTORS = frozenset({"iceberg", "fixed obstacle"})
+
+
 @dataclass(frozen=True)
 class FusionConfig:
     """Fusion and classification parameters (engineering defaults, unverified)."""
@@ -49,6 +53,9 @@ class FusionConfig:
     min_extent_m: float = 10.0  # smallest absorbing radius of a target, m
     absorb_lengths: float = 0.75  # absorbing radius in target lengths
     revive_s: float = 30.0  # a new track where a target ended less than this ago takes its id
+    # ... and where a still target (iceberg, fixed obstacle) ended less than this ago: it is still there when a
+    # weak far echo comes back (busy_open_sea: bergs at 700-1000 m lost by the radar for 60-70 s)
+    revive_still_s: float = 300.0
     gate_probability: float = 0.9999
     max_distance_m: float = 60.0
     vessel_speed_mps: float = 1.0
@@ -142,7 +149,8 @@ class Fuser:
         for target in self.targets:
             if not target.members and target.last_x is not None:
                 self._ended.append(target)
-        self._ended = [t for t in self._ended if t_s - t.last_t_s <= cfg.revive_s]
+        self._ended = [t for t in self._ended if t_s - t.last_t_s <= (
+            cfg.revive_still_s if t.descriptor in STILL_DESCRIPTORS else cfg.revive_s)]
         self.targets = [t for t in self.targets if t.members]
         for target in self.targets:
             x, _ = self._estimate(target, states)
@@ -217,7 +225,9 @@ class Fuser:
         """The recently ended target whose footprint (its last state predicted to ``t_s``) holds ``state``."""
         best, best_d = None, np.inf
         for target in self._ended:
-            centre = ekf.predict_mean(target.last_x, t_s - target.last_t_s)
+            # a still target is where it was: its last small speed (drift of a noisy track) is not carried on
+            centre = target.last_x if target.descriptor in STILL_DESCRIPTORS else \
+                ekf.predict_mean(target.last_x, t_s - target.last_t_s)
             if self._inside(state, centre, target.radius_m):
                 d = float(np.hypot(*(state[0][:2] - centre[:2])))
                 if d < best_d:

@@ -83,6 +83,24 @@ def test_a_new_track_where_a_target_just_ended_takes_its_id():
     assert elsewhere.target.target_id not in (first.target.target_id, late.target.target_id)
 
 
+def test_a_still_target_keeps_its_id_when_its_echo_comes_back_minutes_later_where_it_was():
+    fuser = Fuser(FusionConfig(revive_s=30.0, revive_still_s=300.0))
+    berg = make_track(1, "radar", 800.0, 0.0, var=25.0)
+    for t in range(1, 26):  # still for longer than settle_s (20 s): a fixed obstacle (50 m2: too small for a berg)
+        (first,) = fuser.step(float(t), {"radar": [berg]})
+    assert first.target.descriptor == "fixed obstacle"
+    drifting = make_track(1, "radar", 800.0, 0.0, var=25.0, t=26.0)
+    drifting.x[ekf.PSI], drifting.x[ekf.U] = np.radians(90.0), 0.4  # the last update left a small drift eastwards
+    fuser.step(26.0, {"radar": [drifting]})
+    fuser.step(27.0, {"radar": []})  # the far echo is lost
+    # 200 s later (0.4 m/s x 200 s = 80 m of drift, were it carried on) a track where the obstacle was
+    (again,) = fuser.step(227.0, {"radar": [make_track(2, "radar", 805.0, 3.0, var=25.0, t=227.0)]})
+    assert again.target.target_id == first.target.target_id
+    fuser.step(228.0, {"radar": []})
+    (late,) = fuser.step(600.0, {"radar": [make_track(3, "radar", 800.0, 0.0, var=25.0, t=600.0)]})  # 373 s: new
+    assert late.target.target_id != first.target.target_id
+
+
 def test_a_radar_target_inside_an_ais_ship_folds_into_the_older_target():
     fuser = Fuser(FusionConfig())
     fuser.lengths_by_mmsi = {257000002: 100.0}
