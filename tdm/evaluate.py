@@ -54,10 +54,19 @@ Detection
     null when it was visible but never matched (it is then in ``missed_objects``). Per
     object, ``latency_from_first_in_range_s`` counts from the first in-range epoch instead.
     ``detection_latency_max_s`` is over the objects matched at least once.
+Hidden objects ("don't care")
+    An object within a sensor's range that the sensor's ray truth says it cannot see
+    (radar sweeps' ``object_id``, LiDAR points' ``object_id``: occluded, below the horizon)
+    and that no other sensor sees is neither to be found nor a false alarm: at each epoch
+    the reports are assigned (same cost and cut-off) to the in-range and the hidden
+    objects together, and those given to hidden objects are ignored (``ignored_reports``),
+    the MOT/KITTI "don't care" convention. A tracker that coasts through an occlusion is
+    not punished for it.
 False targets
     A target id is false when it is matched at fewer than half of the epochs it is
-    reported at; ``false_targets_per_min`` = number of false ids / (manifest ``duration_s``
-    / 60). ``false_reports_per_min`` = unmatched (target, epoch) reports per minute.
+    reported at (ignored reports not counted); ``false_targets_per_min`` = number of false
+    ids / (manifest ``duration_s`` / 60). ``false_reports_per_min`` = unmatched, not
+    ignored (target, epoch) reports per minute.
 ID switches
     Per truth object, the number of changes of the matched target id between its consecutive
     matched epochs (gaps do not count as switches); ``id_switches`` is the total,
@@ -151,7 +160,9 @@ DEFINITIONS = {
                            "matched",
     "false_targets_per_min": "target ids matched at fewer than half of their reported epochs, per minute of "
                              "manifest duration",
-    "false_reports_per_min": "unmatched (target, epoch) reports per minute",
+    "false_reports_per_min": "unmatched (target, epoch) reports per minute, ignored ones not counted",
+    "ignored_reports": "reports assigned to objects within a sensor's range but hidden from every sensor (ray "
+                       "truth): neither matched nor false",
     "id_switches": "total over objects of changes of matched target id between consecutive matched epochs",
     "nees": "mean of e^T P^-1 e over matched pairs (ideal 2); nees_fraction_in_95: inside [0.0506, 7.378]",
     "classification_accuracy": "matched ship/iceberg pairs whose descriptor is vessel/iceberg",
@@ -490,15 +501,16 @@ def _range_param(recording: Path, scenario: dict, sensor: str, key: str, default
                    f"sensors.{sensor}.{key}")
 
 
-def _visibility(recording: Path, scenario: dict, manifest: dict, truth: TruthAtEpochs) -> tuple[dict, dict]:
-    """Per rendered sensor, the (E, K) in-range mask; and the parameters used."""
+def _visibility(recording: Path, scenario: dict, manifest: dict, truth: TruthAtEpochs) -> tuple[dict, dict, dict]:
+    """Per rendered sensor, the (E, K) in-range mask; per sensor whose view is ray truth, the (E, K) mask of
+    objects within its range but hidden from it (occluded, below the horizon); and the parameters used."""
     present = np.isfinite(truth.range_m)
     rng = np.where(present, truth.range_m, np.inf)
     rendered = _rendered(manifest, scenario)
     radar_range_m = _range_param(recording, scenario, "radar", "range_m", math.inf)
     ais_range_m = _range_param(recording, scenario, "ais", "range_m", math.inf)
     lidar_range_m = _range_param(recording, scenario, "lidar", "range_max_m", DEFAULT_LIDAR_RANGE_M)
-    visible = {}
+    visible, hidden = {}, {}
     lidar_mode = radar_mode = None
     if "radar" in rendered:
         visible["radar"] = rng <= radar_range_m
@@ -509,6 +521,7 @@ def _visibility(recording: Path, scenario: dict, manifest: dict, truth: TruthAtE
             for k, object_id in enumerate(truth.ids):  # loop over objects
                 if int(object_id) in seen:
                     mask[:, k] = _overlaps(*seen[int(object_id)], truth.t_s, LIDAR_VISIBLE_WINDOW_S)
+            hidden["radar"] = visible["radar"] & present & ~mask
             visible["radar"] &= mask
     if "ais" in rendered:
         visible["ais"] = truth.ais & (rng <= ais_range_m)
@@ -525,9 +538,10 @@ def _visibility(recording: Path, scenario: dict, manifest: dict, truth: TruthAtE
                 if h is not None:
                     mask[:, k] = _overlaps(h, h, truth.t_s, LIDAR_VISIBLE_WINDOW_S)
             visible["lidar"] = mask & present
+            hidden["lidar"] = (rng <= lidar_range_m) & present & ~mask
     params = {"sensors_rendered": rendered, "radar_range_m": radar_range_m, "ais_range_m": ais_range_m,
               "lidar_range_max_m": lidar_range_m, "lidar_visibility": lidar_mode, "radar_visibility": radar_mode}
-    return visible, params
+    return visible, hidden, params
 
 
 # ----------------------------------------------------------------------------------------------- scoring
@@ -566,8 +580,13 @@ def _nees(err_m: np.ndarray, cov_m2: np.ndarray) -> np.ndarray:
 
 
 def _score(truth: TruthAtEpochs, visible: np.ndarray, reports: dict[str, np.ndarray], report_epoch: np.ndarray,
-           c_m: float, p: float, duration_s: float, lidar_range_m: float, with_series: bool) -> dict:
-    """The metrics of one report set against the in-range truth (module docstring)."""
+           c_m: float, p: float, duration_s: float, lidar_range_m: float, with_series: bool,
+           dont_care: np.ndarray | None = None) -> dict:
+    """The metrics of one report set against the in-range truth (module docstring).
+
+    ``dont_care`` (E, K): objects hidden from the sensors though within their range; reports that the
+    assignment gives to them are ignored (neither matched nor false).
+    """
     E, K = visible.shape
     t_s = truth.t_s
     kept = np.flatnonzero(report_epoch >= 0)
@@ -579,9 +598,17 @@ def _score(truth: TruthAtEpochs, visible: np.ndarray, reports: dict[str, np.ndar
     per_epoch = {name: np.zeros(E) for name in ("ospa", "gospa", "gospa_loc", "gospa_missed", "gospa_false")}
     n_vis_e, n_rep_e = visible.sum(axis=1), np.diff(bounds)
     pairs_e, pairs_k, pairs_r, pairs_d = [], [], [], []
+    is_ignored = np.zeros(report_epoch.size, dtype=bool)
     for e in range(E):  # loop over epochs (scans); each assignment is a small matrix
         rows = order[bounds[e]:bounds[e + 1]]
         ks = np.flatnonzero(visible[e])
+        hs = np.flatnonzero(dont_care[e] & ~visible[e]) if dont_care is not None else np.zeros(0, np.int64)
+        if hs.size and rows.size:  # reports of hidden objects leave the set (one assignment over both)
+            rj, cj = assign_distances(distance_matrix(truth_pos[e, np.r_[ks, hs]], rep_pos[rows]), c_m, p)
+            drop = cj[rj >= ks.size]
+            is_ignored[rows[drop]] = True
+            rows = np.delete(rows, drop)
+            n_rep_e[e] = rows.size
         d = distance_matrix(truth_pos[e, ks], rep_pos[rows])
         per_epoch["ospa"][e] = ospa_distances(d, c_m, p)
         g = gospa_distances(d, c_m, p, GOSPA_ALPHA)
@@ -648,10 +675,11 @@ def _score(truth: TruthAtEpochs, visible: np.ndarray, reports: dict[str, np.ndar
     is_matched = np.zeros(report_epoch.size, dtype=bool)
     is_matched[pr] = True
     uids, inv = np.unique(reports["target_id"][kept], return_inverse=True)
-    n_reported = np.bincount(inv, minlength=uids.size)
+    n_reported = np.bincount(inv, weights=~is_ignored[kept], minlength=uids.size)
     n_matched_id = np.bincount(inv, weights=is_matched[kept], minlength=uids.size)
-    false_ids = uids[n_matched_id < 0.5 * n_reported]
-    n_false_reports = int(kept.size - np.count_nonzero(is_matched[kept]))
+    false_ids = uids[(n_matched_id < 0.5 * n_reported) & (n_reported > 0)]
+    n_ignored = int(np.count_nonzero(is_ignored[kept]))
+    n_false_reports = int(kept.size - n_ignored - np.count_nonzero(is_matched[kept]))
 
     out = {
         "ospa_m": float(np.mean(per_epoch["ospa"])) if E else math.nan,
@@ -676,6 +704,7 @@ def _score(truth: TruthAtEpochs, visible: np.ndarray, reports: dict[str, np.ndar
         "false_target_ids": [int(x) for x in false_ids],
         "false_targets_per_min": false_ids.size / duration_min if duration_min > 0 else math.nan,
         "false_reports": n_false_reports,
+        "ignored_reports": n_ignored,
         "false_reports_per_min": n_false_reports / duration_min if duration_min > 0 else math.nan,
         "id_switches": switches_total,
         "id_switches_max_per_object": switches_max,
@@ -778,22 +807,26 @@ def evaluate(recording: Path, c_m: float = DEFAULT_CUTOFF_M, p: float = DEFAULT_
     t0_s, t1_s = float(np.min(truth_rows["t"])), float(np.max(truth_rows["t"]))
     epochs = _epochs(targets["t"], rate_hz, t0_s, t1_s)
     truth = _truth_at(truth_rows, epochs)
-    visible_by_sensor, params = _visibility(recording, scenario, manifest, truth)
+    visible_by_sensor, hidden_by_sensor, params = _visibility(recording, scenario, manifest, truth)
     visible = np.zeros(truth.range_m.shape, dtype=bool)
     for mask in visible_by_sensor.values():
         visible |= mask
+    hidden = np.zeros(truth.range_m.shape, dtype=bool)
+    for mask in hidden_by_sensor.values():
+        hidden |= mask
     duration_s = float(manifest.get("duration_s") or (t1_s - t0_s))
     lidar_range_m = params["lidar_range_max_m"]
 
     metrics = _score(truth, visible, targets, _epoch_index(targets["t"], epochs), c_m, p, duration_s,
-                     lidar_range_m, with_series=True)
+                     lidar_range_m, with_series=True, dont_care=hidden & ~visible)
     per_sensor = {}
     if tracks is not None:
         track_epoch = _epoch_index(tracks["t"], epochs)
         for sensor in sorted({str(s) for s in tracks["sensor"]}):
             mask = tracks["sensor"] == sensor
             per_sensor[sensor] = _score(truth, visible_by_sensor.get(sensor, visible), _subset(tracks, mask),
-                                        track_epoch[mask], c_m, p, duration_s, lidar_range_m, with_series=False)
+                                        track_epoch[mask], c_m, p, duration_s, lidar_range_m, with_series=False,
+                                        dont_care=hidden_by_sensor.get(sensor))
     metrics["per_sensor"] = per_sensor
     metrics["parameters"] = {**params, "c_m": c_m, "p": p, "gospa_alpha": GOSPA_ALPHA, "update_rate_hz": rate_hz,
                              "duration_s": duration_s, "moving_sog_mps": MOVING_SOG_MPS,

@@ -327,3 +327,21 @@ def test_a_glimpse_does_not_start_the_latency_clock():
     assert _sustained_start(vis_e, t_s) == 12
     assert _sustained_start(np.arange(0, 6), t_s) == 0  # 0..5 s: a 5 s run counts from its start
     assert _sustained_start(np.r_[4, 5, 9], t_s) == 4  # never in view 5 s: the first in-range epoch
+
+
+def test_reports_of_an_object_hidden_from_the_radar_are_neither_matched_nor_false(tmp_path):
+    rec = make_recording(tmp_path / "rec")
+    sweeps = rec / "radar" / "sweeps"
+    sweeps.mkdir(parents=True)
+    for rev in range(8):  # 2.5 s revolutions; bravo (id 2) hidden behind something in revolutions 2-4 (5-12.5 s)
+        ids = [1, 3] if 2 <= rev <= 4 else [1, 2, 3]
+        np.savez(sweeps / f"{rev:06d}.npz", time=2.5 * rev + np.arange(8) * 2.5 / 8,
+                 object_id=np.array(ids, np.int32), object_spokes=np.full(len(ids), 10, np.int32))
+    m = evaluate(rec)
+    assert m["parameters"]["radar_visibility"] == "rays"
+    # bravo's epochs 6-11 s are out of view (no revolution reaching it within +-0.5 s): its 6 reports are ignored
+    assert m["ignored_reports"] == 6
+    assert m["in_range_pairs"] == 84 - 6 and m["matched_pairs"] == 79 - 6
+    assert m["false_reports"] == 21 and m["false_target_ids"] == [99]  # only target 99, as without ray truth
+    bravo = next(o for o in m["per_object"] if o["name"] == "bravo")
+    assert bravo["epochs_in_range"] == 21 - 6
