@@ -81,7 +81,7 @@ RECORDINGS = (("busy_open_sea", "ss_bos"), ("crossing_silent_ship", "ss_css"))
 #: Process-noise intensities swept, m^2/s^3 (ConstantVelocity noise_diff_coeff).
 Q_SWEEP = (0.001, 0.01, 0.1, 1.0, 10.0)
 #: Files of a recording the evaluation reads (linked into each scoring directory).
-LINKED = ("truth.jsonl", "scenario.yaml", "manifest.json", "ownship.jsonl", "lidar")
+LINKED = ("truth.jsonl", "scenario.yaml", "manifest.json", "ownship.jsonl", "lidar", "radar")
 #: Stone Soup trackers: name -> sensors whose scans it takes.
 STONESOUP_TRACKERS = {"lidar": ("lidar",), "radar": ("radar",), "central": ("lidar", "radar"),
                       "central_ais": ("lidar", "radar", "ais")}
