@@ -193,24 +193,16 @@ def execute_run(spec: RunSpec, batch_dir: str) -> dict:
     traceback goes to ``results/<run>.log``. The TDM runs in the task's own process (no front-end
     workers: the batch's parallelism is across runs).
     """
-    from raysim.render import render
-    from tdm.cli import evaluate_command, run_command
+    from raysim.runner import render_detect_evaluate
 
     batch = Path(batch_dir)
     results = batch / "results"
     results.mkdir(parents=True, exist_ok=True)
     row = _row(spec)
-    metrics: dict = {}
-
-    def detect_and_evaluate(staged: Path) -> dict[str, int]:
-        result = run_command(staged, workers=0, progress=False)
-        metrics.update(evaluate_command(staged))
-        return {"tdm/detected_targets.jsonl": result.n_target_lines, "tdm/targets": result.n_targets}
-
     started = time.perf_counter()
     log = results / f"{spec.name}.log"
     try:
-        render(spec.scenario, batch / "runs" / spec.name, progress=False, after_sensors=detect_and_evaluate)
+        _, metrics = render_detect_evaluate(spec.scenario, batch / "runs" / spec.name, progress=False, tdm_workers=0)
         row.update(_metrics_row(metrics), status="ok")
         log.unlink(missing_ok=True)
     except Exception as exc:  # a failed run is recorded and the batch goes on

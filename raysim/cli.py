@@ -163,28 +163,13 @@ def cmd_render(args) -> int:
 
 def cmd_run(args) -> int:
     """The main job: render, run the TDM on the recording, evaluate it; the targets join the bag."""
-    from raysim.render import render
-    from tdm.cli import evaluate_command, run_command
-    from tdm.errors import RecordingError
-
-    metrics: dict = {}
-
-    def detect_and_evaluate(staged: Path) -> dict[str, int]:
-        try:
-            result = run_command(staged, progress=False if args.no_progress else None)
-            metrics.update(evaluate_command(staged))
-        except RecordingError as exc:  # the recording was just written: this is a bug, not bad input
-            raise RuntimeError(f"tdm failed on the fresh recording: {exc}") from exc
-        counts = {"tdm/detected_targets.jsonl": result.n_target_lines, "tdm/targets": result.n_targets}
-        counts.update({f"tdm/warnings/{k}": v for k, v in result.warnings.items()})
-        return counts
-
-    scenario = _load(args)
-    result = render(scenario, _out_dir(args, scenario), progress=False if args.no_progress else None,
-                    formats=args.formats, after_sensors=detect_and_evaluate)
-    _summary(result)
+    from raysim.runner import render_detect_evaluate
     from tdm.evaluate import format_table
 
+    scenario = _load(args)
+    result, metrics = render_detect_evaluate(scenario, _out_dir(args, scenario),
+                                             progress=False if args.no_progress else None, formats=args.formats)
+    _summary(result)
     print(format_table(metrics))
     return 0
 

@@ -584,8 +584,9 @@ def _score(truth: TruthAtEpochs, visible: np.ndarray, reports: dict[str, np.ndar
            dont_care: np.ndarray | None = None) -> dict:
     """The metrics of one report set against the in-range truth (module docstring).
 
-    ``dont_care`` (E, K): objects hidden from the sensors though within their range; reports that the
-    assignment gives to them are ignored (neither matched nor false).
+    ``dont_care`` (E, K): objects hidden from the sensors though within their range (those in range at
+    an epoch are never don't care); reports that the assignment gives to them are ignored (neither
+    matched nor false).
     """
     E, K = visible.shape
     t_s = truth.t_s
@@ -818,7 +819,7 @@ def evaluate(recording: Path, c_m: float = DEFAULT_CUTOFF_M, p: float = DEFAULT_
     lidar_range_m = params["lidar_range_max_m"]
 
     metrics = _score(truth, visible, targets, _epoch_index(targets["t"], epochs), c_m, p, duration_s,
-                     lidar_range_m, with_series=True, dont_care=hidden & ~visible)
+                     lidar_range_m, with_series=True, dont_care=hidden)
     per_sensor = {}
     if tracks is not None:
         track_epoch = _epoch_index(tracks["t"], epochs)
