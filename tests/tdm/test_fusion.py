@@ -110,3 +110,28 @@ def test_a_radar_target_inside_an_ais_ship_folds_into_the_older_target():
                            "ais": [make_track(5, "ais", 0.0, 0.0, var=5.0, mmsi=257000002)]})
     assert len(out) == 1 and out[0].target.target_id == radar_only.target.target_id
     assert out[0].target.mmsi == 257000002
+
+
+def test_a_ship_passing_close_to_a_still_berg_does_not_swallow_it():
+    """busy_open_sea seeds 9 and 11: a 100 m ship with AIS passes 40 m from a berg the radar has tracked
+    for a while; the berg's target is not folded into the ship's (two objects), and keeps its id."""
+    fuser = Fuser(FusionConfig())
+    fuser.lengths_by_mmsi = {257000002: 100.0}
+    berg = make_track(1, "radar", 0.0, 0.0, var=25.0)
+    berg.x[ekf.ALPHA] = 400.0
+    for t in range(1, 26):  # settles as an iceberg (20 s still, 400 m2)
+        (first,) = fuser.step(float(t), {"radar": [berg]})
+    assert first.target.descriptor == "iceberg"
+    berg_id = first.target.target_id
+    for t in range(26, 66):  # the ship steams north at 5 m/s, 40 m east of the berg: -100 m .. +95 m
+        north = -100.0 + 5.0 * (t - 26)
+        ship = make_track(5, "ais", 40.0, north, var=5.0, t=float(t), mmsi=257000002)
+        ship.x[ekf.U] = 5.0
+        ship_radar = make_track(2, "radar", 40.0, north, var=25.0, t=float(t))
+        ship_radar.x[ekf.U] = 5.0
+        berg_now = make_track(1, "radar", 0.0, 0.0, var=25.0, t=float(t))
+        berg_now.x[ekf.ALPHA] = 400.0
+        out = fuser.step(float(t), {"radar": [berg_now, ship_radar], "ais": [ship]})
+        assert len(out) == 2, t
+        (berg_target,) = [e.target for e in out if e.target.mmsi is None]
+        assert berg_target.target_id == berg_id and berg_target.descriptor == "iceberg"
