@@ -44,6 +44,11 @@ class Detections:
         How far each detection stands out of its background, dB: for a radar plot, its peak
         beam-integrated power over the local clutter level (:func:`tdm.frontend.radar.clutter_map`).
         None when the front end has no such measure (LiDAR).
+    beam_fill : (N,) float64 or None
+        For a radar plot, its azimuth extent over the extent the two-way antenna beam paints
+        between the plot's strongest and weakest cells (:func:`tdm.frontend.radar.radar_detections`):
+        about 1 or more for an echo received through the antenna, well under 1 for a return
+        narrower than the beam can make (a sea spike, interference). None for LiDAR.
     """
 
     sensor: str
@@ -59,6 +64,7 @@ class Detections:
     n_cells: np.ndarray
     range_m: np.ndarray
     strength_db: np.ndarray | None = None
+    beam_fill: np.ndarray | None = None
 
     def __len__(self) -> int:
         return int(self.time_s.shape[0])

@@ -70,7 +70,10 @@ class TdmConfig:
         init_speed_sigma_mps=4.0, max_speed_mps=15.0,
         # plots barely over the clutter count half a hit, plots well over it 1.5 (TrackerConfig; busy_open_sea,
         # 300 s: 3.2 -> 0.8 false targets a minute, and strong new objects confirm a scan sooner)
-        weak_below_db=13.0, strong_from_db=15.0))
+        weak_below_db=13.0, strong_from_db=15.0,
+        # a plot narrower than the beam paints is a sea spike, however strong: a weak hit (Detections.beam_fill;
+        # busy_open_sea seeds 7-11, 300 s: 0.6-1.0 -> 0-0.4 false targets a minute)
+        min_beam_fill=0.5))
     ais_tracker: AisTrackerConfig = field(default_factory=AisTrackerConfig)
     fusion_config: FusionConfig = field(default_factory=FusionConfig)
 

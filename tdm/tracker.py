@@ -63,6 +63,10 @@ class TrackerConfig:
         confirm in two scans and keeps marginal clutter from confirming in three or four. None:
         every hit counts 1 (LiDAR).
     weak_hit : float
+    min_beam_fill : float or None
+        A detection whose :attr:`~tdm.detections.Detections.beam_fill` is under this is narrower than an
+        echo through the antenna can be (a sea spike): it counts ``weak_hit`` whatever its strength.
+        None: not checked (LiDAR).
     max_speed_mps : float
         A track faster than this (20 m/s = 39 kn: faster than the ships this TDM is for) is
         deleted: it is clutter joined across scans.
@@ -82,6 +86,7 @@ class TrackerConfig:
     weak_below_db: float | None = None
     strong_from_db: float | None = None
     weak_hit: float = 0.5
+    min_beam_fill: float | None = None
     max_speed_mps: float = 20.0
     process: ekf.ProcessNoise = field(default_factory=ekf.ProcessNoise)
 
@@ -222,6 +227,8 @@ class PositionTracker:
     def _hit_weight(self, dets: Detections, j: int) -> float:
         """How much detection ``j`` counts towards confirmation (:class:`TrackerConfig` weak/strong)."""
         cfg = self.config
+        if cfg.min_beam_fill is not None and dets.beam_fill is not None and dets.beam_fill[j] < cfg.min_beam_fill:
+            return cfg.weak_hit
         if dets.strength_db is None:
             return 1.0
         strength = float(dets.strength_db[j])

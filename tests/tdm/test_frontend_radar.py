@@ -219,6 +219,22 @@ def test_plots_on_the_own_ship_are_rejected_and_spikes_are_not_plots():
     assert (det.range_m > 0.5 * 10.9 + 5.0).all()
 
 
+def test_an_echo_through_the_beam_fills_it_and_a_spike_narrower_than_the_beam_does_not():
+    config = RadarFrontEndConfig()
+    # a point target through the 5.2 deg two-way beam, peak level 12 (36 dB over level 0)
+    echo = radar_detections(sweep_with(points=[(500, 300, 12)]), static_track(), Mount(), config)
+    assert len(echo) == 1 and echo.beam_fill[0] == pytest.approx(1.0, abs=0.25)
+    # a spike as strong but 4 spokes (0.7 deg) wide with a level-1 skirt: far narrower than the
+    # beam paints between levels 12 and 1
+    spike = sweep_with([(500, 4, 300, 3, 12), (498, 8, 299, 5, 1)])
+    spike["echo"][500:504, 300:303] = 12
+    narrow = radar_detections(spike, static_track(), Mount(), config)
+    assert len(narrow) == 1 and narrow.beam_fill[0] < 0.3
+    # a uniform patch (no dynamic) is compared with one spoke: anything of three spokes or more fills it
+    patch = radar_detections(sweep_with([(500, 30, 300, 4, 8)]), static_track(), Mount(), config)
+    assert patch.beam_fill[0] >= 3.0
+
+
 def test_a_weak_target_stands_out_of_a_quiet_sea_but_not_out_of_equally_strong_clutter():
     config = RadarFrontEndConfig()
     target = (600, 30, 500, 4, 5)  # level 5 over 30 spokes: 23 dB integrated

@@ -90,6 +90,29 @@ def test_strong_plots_confirm_in_two_scans_and_marginal_ones_need_more():
     assert plain.confirmed_tracks()
 
 
+def test_a_strong_plot_narrower_than_the_beam_counts_as_a_weak_hit():
+    cfg = TrackerConfig(confirm_m=3, confirm_n=4, coast_s=10.0, position_floor_m2=0.0, max_range_m=1e4,
+                        weak_below_db=13.0, strong_from_db=15.0, min_beam_fill=0.5)
+
+    def confirmed_after(beam_fill, scans):
+        tracker = PositionTracker("radar", cfg)
+        for k in range(scans):
+            d = scan(2.5 * k, [[600.0, 0.0]])
+            d.strength_db, d.beam_fill = np.array([25.0]), np.array([beam_fill])
+            tracker.process(d, np.zeros(2))
+        return bool(tracker.confirmed_tracks())
+
+    assert confirmed_after(1.0, 2)  # an echo through the antenna: 1.5 + 1.5
+    assert not confirmed_after(0.2, 4)  # a sea spike, however strong: 4 x 0.5
+    unchecked = TrackerConfig(**{**cfg.__dict__, "min_beam_fill": None})
+    tracker = PositionTracker("radar", unchecked)
+    for k in range(2):
+        d = scan(2.5 * k, [[600.0, 0.0]])
+        d.strength_db, d.beam_fill = np.array([25.0]), np.array([0.2])
+        tracker.process(d, np.zeros(2))
+    assert tracker.confirmed_tracks()
+
+
 def test_misses_outside_the_sensor_range_do_not_count():
     cfg = TrackerConfig(confirm_m=3, confirm_n=5, coast_s=100.0, position_floor_m2=0.0, max_range_m=100.0)
     tracker = PositionTracker("lidar", cfg)
