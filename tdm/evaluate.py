@@ -24,8 +24,9 @@ In range (visible)
     At epoch t an object is in range when any rendered sensor could see it: radar:
     distance from the own ship <= ``sensors.radar.range_m`` and, when the sweeps carry
     ``object_id`` / ``object_spokes``, reached by the rays of at least 3 spokes of a
-    revolution that overlaps t +- 0.5 s (not hidden behind another object or below the
-    radar horizon); LiDAR: hit by at least one
+    revolution (not hidden behind another object or below the radar horizon) whose time of
+    seeing it overlaps t +- 0.5 s: from the beam's pass over the object to one revolution
+    later (the next pass); LiDAR: hit by at least one
     LiDAR point whose time is within +-0.5 s of t (``object_id`` of the sweeps; if the
     sweeps carry no ``object_id``: distance <= ``sensors.lidar.range_max_m``); AIS: truth
     ``ais`` true and distance <= ``sensors.ais.range_m``. A sensor counts when it is in the
@@ -330,28 +331,46 @@ def _lidar_hit_times(recording: Path) -> dict[int, np.ndarray] | None:
     return {int(u): times_all[bounds[i]:bounds[i + 1]] for i, u in enumerate(uniq)}
 
 
-def _radar_seen_intervals(recording: Path) -> dict[int, tuple[np.ndarray, np.ndarray]] | None:
-    """Revolutions in which the radar's rays reached each truth object: {id: ((R,) start s, (R,) end s)}.
+def _radar_seen_intervals(recording: Path, truth: TruthAtEpochs) -> dict[int, tuple[np.ndarray, np.ndarray]] | None:
+    """When the radar saw each truth object: {id: ((R,) start s, (R,) end s)}, one interval per revolution.
 
-    An object counts as reached on at least :data:`RADAR_VISIBLE_MIN_SPOKES` spokes of the revolution
-    (its ``object_id`` / ``object_spokes``). None when the sweeps carry no ``object_id``.
+    An object counts as seen in a revolution when its rays reached it on at least
+    :data:`RADAR_VISIBLE_MIN_SPOKES` spokes (the sweep's ``object_id`` / ``object_spokes``). It is
+    seen from the beam's pass over it (the time of the spoke whose compass bearing, azimuth +
+    heading, is nearest the object's bearing from the own ship at the middle of the revolution) until
+    one revolution later, when the next pass looks again. None when the sweeps carry no ``object_id``.
     """
     files = sorted((Path(recording) / "radar" / "sweeps").glob("*.npz"))
     if not files:
         return None
+    column = {int(object_id): k for k, object_id in enumerate(truth.ids)}
+    fields = ("object_id", "object_spokes", "time", "azimuth_deg", "heading_deg")
     seen: dict[int, list[tuple[float, float]]] = {}
     for file in files:  # loop over sweeps, a few ids each
         try:
             with np.load(file) as z:
-                if "object_id" not in z.files or "object_spokes" not in z.files or "time" not in z.files:
+                if not set(fields) <= set(z.files):
                     return None
-                ids, spokes, t = z["object_id"], z["object_spokes"], z["time"]
+                ids, spokes, t, azimuth_deg, heading_deg = (z[name] for name in fields)
         except (OSError, ValueError, KeyError) as exc:
             raise RecordingError(str(file), "(file)", f"not a readable NPZ: {exc}") from None
         if t.size == 0:
             continue
-        for object_id in ids[spokes >= RADAR_VISIBLE_MIN_SPOKES]:
-            seen.setdefault(int(object_id), []).append((float(t[0]), float(t[-1])))
+        period_s = float(t[-1] - t[0]) * t.size / max(t.size - 1, 1)
+        reached = [int(i) for i in ids[spokes >= RADAR_VISIBLE_MIN_SPOKES] if int(i) in column]
+        if not reached:
+            continue
+        k = np.array([column[i] for i in reached])
+        t_mid = 0.5 * float(t[0] + t[-1])
+        east = np.array([np.interp(t_mid, truth.t_s, truth.east_m[:, j]) for j in k])  # a few objects
+        north = np.array([np.interp(t_mid, truth.t_s, truth.north_m[:, j]) for j in k])
+        bearing_deg = np.degrees(np.arctan2(east - np.interp(t_mid, truth.t_s, truth.own_east_m),
+                                            north - np.interp(t_mid, truth.t_s, truth.own_north_m)))
+        compass_deg = azimuth_deg.astype(np.float64) + heading_deg.astype(np.float64)
+        off = np.abs((compass_deg[None, :] - bearing_deg[:, None] + 180.0) % 360.0 - 180.0)
+        t_pass = np.where(np.isfinite(bearing_deg), t[np.argmin(off, axis=1)], t[0])
+        for object_id, start in zip(reached, t_pass):
+            seen.setdefault(object_id, []).append((float(start), float(start) + period_s))
     return {k: (np.array([a for a, _ in v]), np.array([b for _, b in v])) for k, v in seen.items()}
 
 
@@ -514,7 +533,7 @@ def _visibility(recording: Path, scenario: dict, manifest: dict, truth: TruthAtE
     lidar_mode = radar_mode = None
     if "radar" in rendered:
         visible["radar"] = rng <= radar_range_m
-        seen = _radar_seen_intervals(recording)
+        seen = _radar_seen_intervals(recording, truth)
         radar_mode = "range" if seen is None else "rays"
         if seen is not None:
             mask = np.zeros(rng.shape, dtype=bool)

@@ -329,19 +329,40 @@ def test_a_glimpse_does_not_start_the_latency_clock():
     assert _sustained_start(np.r_[4, 5, 9], t_s) == 4  # never in view 5 s: the first in-range epoch
 
 
+def save_sweep(sweeps, rev, ids, spokes=8):
+    """Revolution ``rev`` (2.5 s, ``spokes`` spokes clockwise from the bow, heading north) whose rays reach ``ids``."""
+    np.savez(sweeps / f"{rev:06d}.npz", time=2.5 * rev + np.arange(spokes) * 2.5 / spokes,
+             azimuth_deg=np.arange(spokes) * 360.0 / spokes, heading_deg=np.zeros(spokes),
+             object_id=np.array(ids, np.int32), object_spokes=np.full(len(ids), 10, np.int32))
+
+
+def test_an_object_comes_into_the_radars_view_when_the_beam_passes_it(tmp_path):
+    rec = make_recording(tmp_path / "rec")
+    sweeps = rec / "radar" / "sweeps"
+    sweeps.mkdir(parents=True)
+    for rev in range(8):  # charlie (id 3, due west: 6 of 8 spokes into a revolution) first reached in revolution 2
+        save_sweep(sweeps, rev, [1, 2, 3] if rev >= 2 else [1, 2])
+    m = evaluate(rec)
+    charlie = next(o for o in m["per_object"] if o["name"] == "charlie")
+    # revolution 2 starts at 5 s; the beam points west at 5 + 6/8 x 2.5 = 6.875 s: in view from epoch 7 (+- 0.5 s)
+    assert charlie["first_in_range_s"] == 7.0 and charlie["in_view_from_s"] == 7.0
+    bravo = next(o for o in m["per_object"] if o["name"] == "bravo")  # due north: the first spoke
+    assert bravo["first_in_range_s"] == 0.0
+
+
 def test_reports_of_an_object_hidden_from_the_radar_are_neither_matched_nor_false(tmp_path):
     rec = make_recording(tmp_path / "rec")
     sweeps = rec / "radar" / "sweeps"
     sweeps.mkdir(parents=True)
     for rev in range(8):  # 2.5 s revolutions; bravo (id 2) hidden behind something in revolutions 2-4 (5-12.5 s)
         ids = [1, 3] if 2 <= rev <= 4 else [1, 2, 3]
-        np.savez(sweeps / f"{rev:06d}.npz", time=2.5 * rev + np.arange(8) * 2.5 / 8,
-                 object_id=np.array(ids, np.int32), object_spokes=np.full(len(ids), 10, np.int32))
+        save_sweep(sweeps, rev, ids)
     m = evaluate(rec)
     assert m["parameters"]["radar_visibility"] == "rays"
     # bravo's epochs 6-11 s are out of view (no revolution reaching it within +-0.5 s): its 6 reports are ignored
     assert m["ignored_reports"] == 6
-    assert m["in_range_pairs"] == 84 - 6 and m["matched_pairs"] == 79 - 6
+    # and charlie (silent, due west) is seen from the beam's first pass over it, 1.875 s in: epochs 0 and 1 less
+    assert m["in_range_pairs"] == 84 - 6 - 2 and m["matched_pairs"] == 79 - 6
     assert m["false_reports"] == 21 and m["false_target_ids"] == [99]  # only target 99, as without ray truth
     bravo = next(o for o in m["per_object"] if o["name"] == "bravo")
     assert bravo["epochs_in_range"] == 21 - 6
