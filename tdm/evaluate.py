@@ -143,7 +143,7 @@ DEFINITIONS = {
     "truth_at_epoch": "position and SOG linearly interpolated in the 0.1 s truth, COG and AIS flag nearest; "
                       "own ship excluded",
     "in_range": "radar: distance <= radar range_m and, if the sweeps carry object_id, reached on >= 3 spokes "
-                "of a revolution within +-0.5 s; lidar: hit by a LiDAR point within +-0.5 s (object_id); "
+                "of a revolution, seen from the beam's pass over it to the next pass, within +-0.5 s; lidar: hit by a LiDAR point within +-0.5 s (object_id); "
                 "ais: truth ais and distance <= ais range_m; any rendered sensor",
     "matching": "per epoch, linear_sum_assignment on min(d, c)^p of targets to in-range truth; pairs with d >= c "
                 "unmatched",
