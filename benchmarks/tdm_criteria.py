@@ -3,6 +3,7 @@
 Usage::
 
     python benchmarks/tdm_criteria.py [--quick] [--fresh] [--out benchmarks/results/tdm_criteria.md] [--json FILE]
+                                      [--batch DIR]...
 
 - Renders scenarios/busy_open_sea.yaml for its full 300 s (into ``/tmp/tdm_bench_bos``, shared with
   benchmarks/tdm_speed.py) and scenarios/crossing_silent_ship.yaml for 120 s (into
@@ -20,10 +21,11 @@ Usage::
   under 13 dB and from 15 dB: the weights of the radar tracker's confirmation
   (``TdmConfig.radar_tracker``: weak_below_db, strong_from_db); and, of the plots from 15 dB, the
   median beam fill and the fraction under 0.5 (``Detections.beam_fill``, min_beam_fill).
-- ``--batch DIR``: also tabulates the criteria of every run of a ``raysim batch`` of
-  busy_open_sea over other seeds (made beforehand, for example
+- ``--batch DIR`` (repeatable): also tabulates the criteria of every run of a ``raysim batch`` of
+  a scenario over other seeds (made beforehand, for example
   ``raysim batch scenarios/busy_open_sea.yaml --seeds 5 -o DIR``: seeds 7-11, the scenario's
-  own first), from each run's ``tdm/metrics.json``.
+  own first; ``raysim batch scenarios/crossing_silent_ship.yaml --seeds 5 --duration 120 -o DIR``),
+  from each run's ``tdm/metrics.json``.
 """
 
 from __future__ import annotations
@@ -170,7 +172,11 @@ def seeds_report(batch: Path) -> str:
 
     with open(batch / "summary.csv", newline="", encoding="utf-8") as f:
         rows = list(csv.DictReader(f))
-    lines = ["", f"## busy_open_sea over seeds (`raysim batch`, {len(rows)} runs)", "",
+    import yaml
+
+    first = next((batch / "runs" / row["run"] / "scenario.yaml" for row in rows), None)
+    name = yaml.safe_load(first.read_text(encoding="utf-8")).get("name", batch.name) if first else batch.name
+    lines = ["", f"## {name} over seeds (`raysim batch`, {len(rows)} runs)", "",
              "The criteria of each run; the objects behind a latency over 10 s and an object with more than one",
              "id switch are named.", "",
              "| seed | duration [s] | " + " | ".join(label for _, label, *_ in CRITERIA) + " | slow objects | switching objects |",
@@ -196,7 +202,8 @@ def main(argv=None) -> int:
     parser.add_argument("--quick", action="store_true", help="busy_open_sea for 90 s only")
     parser.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results" / "tdm_criteria.md")
     parser.add_argument("--json", type=Path, help="also write the figures as JSON")
-    parser.add_argument("--batch", type=Path, help="a raysim batch of busy_open_sea over seeds to tabulate as well")
+    parser.add_argument("--batch", type=Path, action="append", default=[],
+                        help="a raysim batch of a scenario over seeds to tabulate as well (repeatable)")
     args = parser.parse_args(argv)
     results, recordings, durations = {}, {}, {}
     for name, (scenario, duration_s, directory) in SCENARIOS.items():
@@ -207,8 +214,8 @@ def main(argv=None) -> int:
         results[name] = criteria(run_and_evaluate(recordings[name]))
     strengths = plot_strengths(recordings["busy_open_sea"])
     text = report(results, strengths, durations, args.quick)
-    if args.batch:
-        text += seeds_report(args.batch)
+    for batch in args.batch:
+        text += seeds_report(batch)
     print(text)
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(text, encoding="utf-8")
