@@ -94,6 +94,12 @@ def predict(x: np.ndarray, p: np.ndarray, dt_s: float, q: ProcessNoise) -> tuple
     return x_new, 0.5 * (p_new + p_new.T)
 
 
+def velocity_en(x: np.ndarray) -> np.ndarray:
+    """Velocity (..., 2) east, north in m/s of states (..., 6): speed along the course."""
+    x = np.asarray(x, dtype=float)
+    return x[..., U, None] * np.stack([np.sin(x[..., PSI]), np.cos(x[..., PSI])], axis=-1)
+
+
 def predict_mean(x: np.ndarray, dt_s: np.ndarray) -> np.ndarray:
     """Predicted states (..., 6) of states (..., 6) over times (...,) s (no covariance; vectorised)."""
     x = np.asarray(x, dtype=float)

@@ -107,8 +107,9 @@ from tdm.metrics import DEFAULT_CUTOFF_M, DEFAULT_ORDER_P, GOSPA_ALPHA, assign_d
 
 #: Default TDM output rate when the scenario gives none, Hz (DESIGN.md scenario example: ``tdm: {update_rate_hz: 1}``).
 DEFAULT_UPDATE_RATE_HZ = 1.0
-#: Half-width of the window in which a LiDAR hit makes an object visible, s (task definition).
-LIDAR_VISIBLE_WINDOW_S = 0.5
+#: Half-width of the window about an epoch in which a LiDAR hit, or the radar's view of an object, makes it
+#: visible, s (task definition).
+VISIBLE_WINDOW_S = 0.5
 #: Fewest spokes of a revolution whose rays must reach an object for the radar to see it (0.5 deg at 2048
 #: spokes; a radar plot needs 3 spokes too, docs/tdm.md).
 RADAR_VISIBLE_MIN_SPOKES = 3
@@ -143,8 +144,9 @@ DEFINITIONS = {
     "truth_at_epoch": "position and SOG linearly interpolated in the 0.1 s truth, COG and AIS flag nearest; "
                       "own ship excluded",
     "in_range": "radar: distance <= radar range_m and, if the sweeps carry object_id, reached on >= 3 spokes "
-                "of a revolution, seen from the beam's pass over it to the next pass, within +-0.5 s; lidar: hit by a LiDAR point within +-0.5 s (object_id); "
-                "ais: truth ais and distance <= ais range_m; any rendered sensor",
+                "of a revolution, seen from the beam's pass over it to the next pass, within +-0.5 s; "
+                "lidar: hit by a LiDAR point within +-0.5 s (object_id); ais: truth ais and distance <= ais range_m; "
+                "any rendered sensor",
     "matching": "per epoch, linear_sum_assignment on min(d, c)^p of targets to in-range truth; pairs with d >= c "
                 "unmatched",
     "ospa_m": "mean over epochs of OSPA (Schuhmacher 2008) on positions, cut-off c, order p",
@@ -375,7 +377,7 @@ def _radar_seen_intervals(recording: Path, truth: TruthAtEpochs) -> dict[int, tu
 
 
 def _overlaps(starts: np.ndarray, ends: np.ndarray, t_s: np.ndarray, half_window_s: float) -> np.ndarray:
-    """(E,) bool: some interval [start, end] (sorted, disjoint) meets [t - w, t + w]."""
+    """(E,) bool: some interval [start, end] meets [t - w, t + w] (starts ascending, ends ascending)."""
     if starts.size == 0:
         return np.zeros(t_s.shape, dtype=bool)
     idx = np.searchsorted(ends, t_s - half_window_s, side="left")
@@ -539,7 +541,7 @@ def _visibility(recording: Path, scenario: dict, manifest: dict, truth: TruthAtE
             mask = np.zeros(rng.shape, dtype=bool)
             for k, object_id in enumerate(truth.ids):  # loop over objects
                 if int(object_id) in seen:
-                    mask[:, k] = _overlaps(*seen[int(object_id)], truth.t_s, LIDAR_VISIBLE_WINDOW_S)
+                    mask[:, k] = _overlaps(*seen[int(object_id)], truth.t_s, VISIBLE_WINDOW_S)
             hidden["radar"] = visible["radar"] & present & ~mask
             visible["radar"] &= mask
     if "ais" in rendered:
@@ -555,7 +557,7 @@ def _visibility(recording: Path, scenario: dict, manifest: dict, truth: TruthAtE
             for k, object_id in enumerate(truth.ids):  # loop over objects
                 h = hits.get(int(object_id))
                 if h is not None:
-                    mask[:, k] = _overlaps(h, h, truth.t_s, LIDAR_VISIBLE_WINDOW_S)
+                    mask[:, k] = _overlaps(h, h, truth.t_s, VISIBLE_WINDOW_S)
             visible["lidar"] = mask & present
             hidden["lidar"] = (rng <= lidar_range_m) & present & ~mask
     params = {"sensors_rendered": rendered, "radar_range_m": radar_range_m, "ais_range_m": ais_range_m,
@@ -850,7 +852,7 @@ def evaluate(recording: Path, c_m: float = DEFAULT_CUTOFF_M, p: float = DEFAULT_
     metrics["per_sensor"] = per_sensor
     metrics["parameters"] = {**params, "c_m": c_m, "p": p, "gospa_alpha": GOSPA_ALPHA, "update_rate_hz": rate_hz,
                              "duration_s": duration_s, "moving_sog_mps": MOVING_SOG_MPS,
-                             "lidar_visible_window_s": LIDAR_VISIBLE_WINDOW_S,
+                             "lidar_visible_window_s": VISIBLE_WINDOW_S,
                              "nees_95_interval": list(NEES_95_INTERVAL),
                              "frame_origin_lat_lon_deg": [frame.lat0_deg, frame.lon0_deg]}
     metrics["definitions"] = dict(DEFINITIONS)

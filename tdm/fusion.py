@@ -264,11 +264,8 @@ class Fuser:
                 n_ais = ("ais" in older.members) + ("ais" in younger.members)
                 if n_ais == 2:
                     continue
-                if n_ais == 0:
-                    vo = xo[ekf.U] * np.array([np.sin(xo[ekf.PSI]), np.cos(xo[ekf.PSI])])
-                    vy = xy[ekf.U] * np.array([np.sin(xy[ekf.PSI]), np.cos(xy[ekf.PSI])])
-                    if np.hypot(*(vo - vy)) > 2.0:
-                        continue
+                if n_ais == 0 and np.hypot(*(ekf.velocity_en(xo) - ekf.velocity_en(xy))) > 2.0:
+                    continue
                 for sensor, track_id in younger.members.items():
                     if sensor in older.members:
                         older.absorbed.add((sensor, track_id))

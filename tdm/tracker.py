@@ -27,6 +27,9 @@ from tdm import ekf
 from tdm.association import chi2_gate, gnn, mahalanobis2
 from tdm.detections import AisReport, AisStatic, Detections
 
+#: What a strong detection counts towards confirmation (:class:`TrackerConfig` ``strong_from_db``), hits.
+STRONG_HIT = 1.5
+
 
 @dataclass(frozen=True)
 class TrackerConfig:
@@ -233,7 +236,7 @@ class PositionTracker:
             return 1.0
         strength = float(dets.strength_db[j])
         if cfg.strong_from_db is not None and strength >= cfg.strong_from_db:
-            return 1.5
+            return STRONG_HIT
         if cfg.weak_below_db is not None and strength < cfg.weak_below_db:
             return cfg.weak_hit
         return 1.0
@@ -278,7 +281,7 @@ class PositionTracker:
                 continue
             if not track.confirmed:
                 remaining = cfg.confirm_n - len(track.hits)
-                if sum(track.hits) + 1.5 * remaining < cfg.confirm_m:
+                if sum(track.hits) + STRONG_HIT * remaining < cfg.confirm_m:
                     continue
             keep.append(track)
         # one object seen twice: keep the older confirmed track
@@ -289,9 +292,8 @@ class PositionTracker:
                 continue
             xb = ekf.predict_mean(b.x, a.t_s - b.t_s)
             near = max(cfg.merge_distance_m, 0.5 * (a.length_m + b.length_m))
-            va = a.x[ekf.U] * np.array([np.sin(a.x[ekf.PSI]), np.cos(a.x[ekf.PSI])])
-            vb = b.x[ekf.U] * np.array([np.sin(b.x[ekf.PSI]), np.cos(b.x[ekf.PSI])])
-            if np.hypot(*(a.x[:2] - xb[:2])) < near and np.hypot(*(va - vb)) < cfg.merge_speed_mps:
+            moving_alike = np.hypot(*(ekf.velocity_en(a.x) - ekf.velocity_en(b.x))) < cfg.merge_speed_mps
+            if np.hypot(*(a.x[:2] - xb[:2])) < near and moving_alike:
                 dropped.add(b.track_id)
         self.tracks = [t for t in keep if t.track_id not in dropped]
 

@@ -791,18 +791,16 @@ def _plot_cells(echo: np.ndarray, range_m: np.ndarray, config: RadarFrontEndConf
     return nz[detected], integrated, g
 
 
-def _stands_out(lab: np.ndarray, spoke: np.ndarray, sample: np.ndarray, n_labels: int, eligible: np.ndarray,
-                integrated: np.ndarray, g: int, config: RadarFrontEndConfig) -> tuple[np.ndarray, np.ndarray]:
-    """Eligible plots whose peak beam-integrated power reaches their clutter-map threshold.
-
-    Returns ``keep`` (n_labels,) bool and ``margin_db`` (n_labels,) float32: each plot's peak over
-    its clutter level, dB (-inf where not worked out).
+def _margin_over_clutter_db(lab: np.ndarray, spoke: np.ndarray, sample: np.ndarray, n_labels: int,
+                            eligible: np.ndarray, integrated: np.ndarray, g: int,
+                            config: RadarFrontEndConfig) -> np.ndarray:
+    """(n_labels,) float32: each eligible plot's peak beam-integrated power over its clutter level, dB
+    (-inf for the others and for plots with no cell above the lowest seed threshold).
 
     A cell of spoke group k lies in integration windows k - 1 and k and takes the larger; a plot's
     peak is its largest, and the clutter level is worked out for the peak's block only
     (:func:`clutter_map` gives the same threshold for every block).
     """
-    out = np.zeros(n_labels, dtype=bool)
     margin_db = np.full(n_labels, -np.inf, dtype=np.float32)
     a = integrated.shape[0]
     k = spoke // g
@@ -811,7 +809,7 @@ def _stands_out(lab: np.ndarray, spoke: np.ndarray, sample: np.ndarray, n_labels
     # only cells above the lowest seed threshold can be a kept plot's peak
     cells = np.flatnonzero((value >= np.float32(10.0 ** (config.min_seed_db / 10.0))) & eligible[lab])
     if cells.size == 0:
-        return out, margin_db
+        return margin_db
     value, lab_c = value[cells], lab[cells]
     row = np.where(before[cells] > here[cells], (k[cells] - 1) % a, k[cells])
     peak = np.full(n_labels, -np.inf, dtype=np.float32)
@@ -824,8 +822,7 @@ def _stands_out(lab: np.ndarray, spoke: np.ndarray, sample: np.ndarray, n_labels
     level_db = _clutter_level_db(block_db, row[peak_cell] // ba,
                                  sample[cells[peak_cell]] // config.clutter_block_samples, config)
     margin_db[labels] = peak_db - level_db
-    out[labels] = margin_db[labels] >= config.clutter_margin_db
-    return out, margin_db
+    return margin_db
 
 
 def radar_detections(sweep: dict, track: OwnshipTrack, mount: Mount, config: RadarFrontEndConfig) -> Detections:
@@ -903,8 +900,8 @@ def radar_detections(sweep: dict, track: OwnshipTrack, mount: Mount, config: Rad
     n_spk = _spokes_per_label(lab, spoke, n + 1, n_spokes)
     keep = (n_cells >= config.min_plot_cells) & (n_cells <= config.max_plot_cells) & (n_spk >= config.min_plot_spokes)
     keep[0] = False
-    stands_out, margin_db = _stands_out(lab, spoke, sample, n + 1, keep, integrated, g, config)
-    keep &= stands_out
+    margin_db = _margin_over_clutter_db(lab, spoke, sample, n + 1, keep, integrated, g, config)
+    keep &= margin_db >= config.clutter_margin_db
     if not keep.any():
         return Detections.empty("radar", scan_time)
     margin_db = margin_db[np.flatnonzero(keep)].astype(np.float64)
