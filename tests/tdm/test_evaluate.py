@@ -366,3 +366,17 @@ def test_reports_of_an_object_hidden_from_the_radar_are_neither_matched_nor_fals
     assert m["false_reports"] == 21 and m["false_target_ids"] == [99]  # only target 99, as without ray truth
     bravo = next(o for o in m["per_object"] if o["name"] == "bravo")
     assert bravo["epochs_in_range"] == 21 - 6
+
+
+def test_an_unreadable_radar_sweep_is_one_clear_error_and_no_metrics(tmp_path):
+    rec = make_recording(tmp_path / "rec")
+    sweeps = rec / "radar" / "sweeps"
+    sweeps.mkdir(parents=True)
+    for rev in range(3):
+        save_sweep(sweeps, rev, [1, 2, 3])
+    (sweeps / "000001.npz").write_bytes(b"not an npz file")
+    with pytest.raises(RecordingError) as err:
+        evaluate(rec)
+    assert err.value.file.endswith("000001.npz") and "not a readable NPZ" in str(err.value)
+    assert "\n" not in str(err.value) and len(str(err.value)) < 200
+    assert not (rec / "tdm" / "metrics.json").exists()
