@@ -108,20 +108,20 @@ def nav_recording(write_scenario, tmp_path):
 
 def test_every_nmea_line_has_valid_tag_block_and_checksum(nav_recording):
     lines = (nav_recording / "nav" / "nav.nmea").read_text(encoding="ascii").splitlines()
-    assert len(lines) == 3 * 11  # 2 Hz over 5 s: epochs 0, 0.5, ..., 5 s
+    assert len(lines) == 5 * 11  # 2 Hz over 5 s: epochs 0, 0.5, ..., 5 s
     manifest = json.loads((nav_recording / "manifest.json").read_text())
     assert manifest["counts"]["nav/nav.nmea"] == len(lines) and "nav" in manifest["sensors_rendered"]
     for j in range(11):
-        epoch = [_parse(line) for line in lines[3 * j : 3 * j + 3]]
-        assert [fields[0] for _, fields in epoch] == ["GPRMC", "GPGGA", "HEHDT"]
+        epoch = [_parse(line) for line in lines[5 * j : 5 * j + 5]]
+        assert [fields[0] for _, fields in epoch] == ["GPRMC", "GPGGA", "GPVTG", "GPZDA", "HEHDT"]
         assert {unix for unix, _ in epoch} == {int(START_UNIX_S + j * 0.5)}
 
 
 def test_nmea_agrees_with_ownship_at_the_same_epoch(nav_recording):
     rows = {round(r["t"], 4): r for r in _jsonl(nav_recording / "ownship.jsonl")}
     lines = (nav_recording / "nav" / "nav.nmea").read_text(encoding="ascii").splitlines()
-    for j in range(len(lines) // 3):
-        (_, rmc), (_, gga), (_, hdt) = (_parse(line) for line in lines[3 * j : 3 * j + 3])
+    for j in range(len(lines) // 5):
+        (_, rmc), (_, gga), _, _, (_, hdt) = (_parse(line) for line in lines[5 * j : 5 * j + 5])
         t = j * 0.5
         r = rows[t]
         # $GPRMC,hhmmss.ss,A,lat,N,lon,E,sog_kn,cog,ddmmyy,,,A
@@ -252,7 +252,7 @@ def test_same_inputs_same_bytes(write_scenario, tmp_path):
     a = _render(write_scenario, tmp_path, data, "a")
     b = _render(write_scenario, tmp_path, data, "b")
     c = _render(write_scenario, tmp_path, data, "c", "--seed", "8")
-    for name in ("ownship.jsonl", "nav/nav.nmea"):
+    for name in ("ownship.jsonl", "nav/nav.nmea", "nav/nav_plain.nmea"):
         assert (a / name).read_bytes() == (b / name).read_bytes(), name
         assert (a / name).read_bytes() != (c / name).read_bytes(), name
 
