@@ -216,7 +216,7 @@ def build_tracker(q: float, settings: SensorSettings, hold_s: float | None, scan
 
 
 def track_record(t_s: float, track_id: int, sensor: str, x: np.ndarray, p: np.ndarray, frame) -> dict:
-    """One ``sensor_tracks.jsonl`` line (DESIGN.md schema) from a constant-velocity state (4,) and covariance (4, 4)."""
+    """One ``sensor_tracks.jsonl`` line (docs/formats.md schema) from a constant-velocity state (4,) and covariance (4, 4)."""
     east, ve, north, vn = (float(v) for v in x)
     lat, lon = frame.to_geodetic(east, north)
     cov = p[np.ix_((0, 2), (0, 2))]

@@ -7,7 +7,7 @@ Usage::
 Renders ``scenarios/thesis_table32.yaml`` (300 s, one vessel at 5 m/s with an oscillating heading,
 MMSI 257000032, the own ship keeping pace 50 m to the west; ``--quick``: the first 120 s), runs the
 TDM on it (:func:`tdm.pipeline.run_tdm`, default configuration) and computes, for every epoch at
-``t >= 50 s`` (the thesis drops the first 50 s; REFERENCE.md section 5):
+``t >= 50 s`` (the thesis drops the first 50 s; docs/reference.md section 5):
 
 - Which track is the vessel's: at each epoch, among a source's lines (one sensor's tracks in
   ``tdm/sensor_tracks.jsonl``, or the fused targets in ``tdm/detected_targets.jsonl``), the one
@@ -48,15 +48,15 @@ from tdm.io import read_jsonl  # noqa: E402
 SCENARIO = ROOT / "scenarios" / "thesis_table32.yaml"
 #: The vessel's MMSI in scenarios/thesis_table32.yaml.
 VESSEL_MMSI = 257000032
-#: The thesis drops the first 50 s as the transient (REFERENCE.md section 5, Table 3.2), s.
+#: The thesis drops the first 50 s as the transient (docs/reference.md section 5, Table 3.2), s.
 STEADY_FROM_S = 50.0
 #: A track is the vessel's at an epoch when it is the source's nearest to the truth vessel and within this, m (task brief).
 GATE_M = 50.0
 #: Sources in table order; "fused" is detected_targets.jsonl.
 SOURCES = ("ais", "radar", "lidar", "fused")
-#: States compared for "fused beats every sensor" (the thesis's claim, REFERENCE.md section 5).
+#: States compared for "fused beats every sensor" (the thesis's claim, docs/reference.md section 5).
 COMPARED = ("north_m", "east_m", "cog_deg", "sog_mps")
-#: Thesis Table 3.2 (REFERENCE.md section 5): steady-state standard deviations
+#: Thesis Table 3.2 (docs/reference.md section 5): steady-state standard deviations
 #: (pos lat m, pos lon m, heading deg, speed m/s, cross-section m^2).
 THESIS_TABLE32 = {
     "ais": {"north_m": 2.315, "east_m": 1.499, "cog_deg": 3.240, "sog_mps": 0.013, "cross_section_m2": 0.000},
@@ -443,7 +443,7 @@ def main(argv=None) -> int:
         "against truth.jsonl interpolated at each epoch. Position error is of the reported position against the "
         "truth reference point of the vessel (its centre); heading is the reported COG (wrapped difference); "
         "the cross-section figure is the standard deviation of the estimate itself. The thesis's own numbers "
-        "(REFERENCE.md section 5) come from sensors simulated as noisy copies of truth at 0.5 Hz; ours from "
+        "(docs/reference.md section 5) come from sensors simulated as noisy copies of truth at 0.5 Hz; ours from "
         "ray-cast raw data and the TDM's front ends (LiDAR at 10 Hz, radar at 0.4 Hz, AIS at its reporting "
         "rate), so only the order and the claim are comparable.", "",
         *tables(result), "",

@@ -20,7 +20,7 @@ sys.path.insert(0, str(HERE.parent))  # run from a source checkout without insta
 
 from raysim.meshes import BodyMesh, own_ship, pier  # noqa: E402
 
-ODIN_LENGTH_M = 10.9  # own ship Odin (thesis scenario, DESIGN.md)
+ODIN_LENGTH_M = 10.9  # own ship Odin (thesis scenario, scenarios/busy_open_sea.yaml)
 ODIN_BEAM_M = 3.5
 
 

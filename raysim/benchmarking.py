@@ -37,9 +37,9 @@ from raysim.motion import ConstantVelocity, Stationary
 from raysim.scene import Carrier, Scene, SceneObject, pack_rays
 
 HDL32E_ELEVATIONS_DEG = np.linspace(-30.67, 10.67, 32)
-"""HDL-32E laser elevations (REFERENCE.md section 2), degrees."""
+"""HDL-32E laser elevations (docs/reference.md section 2), degrees."""
 HDL32E_AZIMUTH_STEP_DEG = 0.1659
-"""Azimuth step per firing cycle at 10 Hz (REFERENCE.md section 2), degrees."""
+"""Azimuth step per firing cycle at 10 Hz (docs/reference.md section 2), degrees."""
 
 
 # ------------------------------------------------------------------ machine

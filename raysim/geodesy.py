@@ -1,7 +1,7 @@
 """Latitude/longitude <-> local metres about the scenario origin (pyproj).
 
 The local frame is a transverse Mercator projection centred on the origin
-(scale factor 1, WGS84), which REFERENCE.md section 1 allows as the local ENU
+(scale factor 1, WGS84), which docs/reference.md section 1 allows as the local ENU
 frame: x east, y north, metres, exact in both directions. Within the 50 km a
 scenario may span, grid north differs from true north by the meridian
 convergence ``dlon * sin(lat)`` (0.015 deg at 1 km east of 59.4 N); raysim

@@ -6,7 +6,7 @@ properties up per hit with the arrays of :func:`material_table`, vectorised::
     table = material_table()
     rho = table["reflectance_905nm"][face_material[hit_face]]
 
-Sources and conventions (see /work/shared/REFERENCE.md sections 2 and 3):
+Sources and conventions (see docs/reference.md sections 2 and 3):
 
 - ``reflectance_905nm`` is the diffuse (Lambertian) reflectance at the HDL-32E's 905 nm
   wavelength, 0..1. The HDL-32E reports 0-100 % diffuse reflectivity in its reflectivity byte
@@ -122,7 +122,7 @@ def specular_exponent_from_half_width_deg(half_width_deg: float) -> float:
 
 
 # --- Relative permittivities at X band (real part) -------------------------------------------
-# Ice: 3.15 (REFERENCE.md section 3 item 6; fresh/glacier ice is about 3.15-3.2 from MHz to GHz).
+# Ice: 3.15 (docs/reference.md section 3 item 6; fresh/glacier ice is about 3.15-3.2 from MHz to GHz).
 ICE_PERMITTIVITY = 3.15
 # Dry snow, density about 0.3 g/cm^3: er = 1 + 1.7 rho + 0.7 rho^2 ~ 1.57 (Tiuri et al. 1984
 # dry-snow formula, quoted from memory) (unverified); rounded to 1.6.
@@ -216,13 +216,13 @@ MATERIALS: tuple[Material, ...] = (
     _conductor(
         "aluminium", 0.60, False, SMOOTH_HALF_WIDTH_DEG, SMOOTH_ROUGHNESS_M,
         "905 nm: weathered aluminium 0.59-0.61 at 0.9 um (HELIOS++ spectral library, "
-        "REFERENCE.md section 2); radar: metal, 0 dB.",
+        "docs/reference.md section 2); radar: metal, 0 dB.",
     ),
     _dielectric(
         "ice", 0.40, ICE_PERMITTIVITY, ICE_HALF_WIDTH_DEG, ICE_ROUGHNESS_M,
         "905 nm: 0.40, iceberg ice is darker in the near infrared than in the visible "
-        "(REFERENCE.md section 2; value unverified); radar: Fresnel with er = 3.15 "
-        "(REFERENCE.md section 3 item 6), about -11 dB.",
+        "(docs/reference.md section 2; value unverified); radar: Fresnel with er = 3.15 "
+        "(docs/reference.md section 3 item 6), about -11 dB.",
     ),
     _dielectric(
         "snow", 0.80, SNOW_PERMITTIVITY, VERY_ROUGH_HALF_WIDTH_DEG, SNOW_ROUGHNESS_M,
@@ -245,7 +245,7 @@ MATERIALS: tuple[Material, ...] = (
     ),
     _dielectric(
         "asphalt", 0.28, ASPHALT_PERMITTIVITY, VERY_ROUGH_HALF_WIDTH_DEG, ASPHALT_ROUGHNESS_M,
-        "905 nm: asphalt 0.28 at 0.9 um (HELIOS++ spectral library, REFERENCE.md section 2); "
+        "905 nm: asphalt 0.28 at 0.9 um (HELIOS++ spectral library, docs/reference.md section 2); "
         "radar: Fresnel with er = 4.0 (unverified).",
     ),
     _dielectric(
@@ -255,12 +255,12 @@ MATERIALS: tuple[Material, ...] = (
     ),
     _conductor(
         "retroreflector", 1.0, True, CORNER_REFLECTOR_HALF_WIDTH_DEG, SMOOTH_ROUGHNESS_M,
-        "905 nm: retro-reflective (HDL-32E reports 101-255, REFERENCE.md section 2), "
+        "905 nm: retro-reflective (HDL-32E reports 101-255, docs/reference.md section 2), "
         "diffuse part 1.0 (unverified); radar: 0 dB, corner-reflector-like lobe (unverified).",
     ),
     _dielectric(
         "sea", 0.02, SEA_WATER_PERMITTIVITY, SMOOTH_HALF_WIDTH_DEG, 0.0,
-        "905 nm: 0.02, Fresnel reflectance of water, specular (REFERENCE.md section 2); "
+        "905 nm: 0.02, Fresnel reflectance of water, specular (docs/reference.md section 2); "
         "radar: Fresnel with sea-water er = 60 at X band (unverified).",
     ),
 )

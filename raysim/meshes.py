@@ -7,7 +7,7 @@ centre of the waterline footprint for floating objects, the landward end centre 
 Every generator returns a :class:`BodyMesh`: float64 vertices, int64 triangles, and one
 material index per triangle into :data:`raysim.materials.MATERIALS`. Generated meshes are
 closed (watertight) per component and smooth: the ray engine (Embree) is up to five times
-slower on spiky meshes (REFERENCE.md section 7).
+slower on spiky meshes (docs/reference.md section 7).
 
 Default dimensions of generated ships are rules of thumb chosen to look plausible on sensors
 (unverified, documented on each function); scenarios can override length, beam and height.

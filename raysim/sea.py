@@ -2,7 +2,7 @@
 
 Calm water is a specular mirror at 905 nm (Fresnel reflectance about 2 %): a
 mast-mounted LiDAR at grazing angles gets nothing back from it. Foam on breaking
-crests is a diffuse reflector and does return points (REFERENCE.md section 2,
+crests is a diffuse reflector and does return points (docs/reference.md section 2,
 VRX issues 29/135). raysim models the fraction of the sea covered by whitecaps
 from the wind with Monahan & O'Muircheartaigh (1980),
 ``W = 3.84e-6 U10^3.41`` (U10 in m/s, W a fraction), using the larger of the

@@ -22,7 +22,7 @@ from raysim.random_streams import stream
 from raysim.scenario import Scenario, ShipAis, WaveMotion as WaveMotionConfig
 from raysim.trajectory_csv import read_trajectory_csv
 
-KNOT_MPS = 1852.0 / 3600.0  # REFERENCE.md section 1
+KNOT_MPS = 1852.0 / 3600.0  # docs/reference.md section 1
 
 
 @dataclass(frozen=True)

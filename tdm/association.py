@@ -1,4 +1,4 @@
-"""Data association: Mahalanobis gating and global nearest neighbour (REFERENCE.md section 5).
+"""Data association: Mahalanobis gating and global nearest neighbour (docs/reference.md section 5).
 
 GNN is the optimal one-to-one assignment (``scipy.optimize.linear_sum_assignment``) of
 measurements to tracks on the squared Mahalanobis distance, with pairs outside the gate

@@ -1,4 +1,4 @@
-"""The ``tdm`` command (DESIGN.md command-line contract).
+"""The ``tdm`` command (docs/contracts.md "Command line").
 
 - ``tdm run RECORDING [-o DIR] [--fusion simple|ci] [--lidar-source auto|npz|pcap] [--workers N]``
   writes ``DIR/detected_targets.jsonl`` and ``DIR/sensor_tracks.jsonl`` (default DIR = RECORDING/tdm);

@@ -1,4 +1,4 @@
-"""The thesis's tracked-object model as an extended Kalman filter (REFERENCE.md section 5).
+"""The thesis's tracked-object model as an extended Kalman filter (docs/reference.md section 5).
 
 State ``x = [east_m, north_m, course_rad, speed_mps, turn_rate_radps, cross_section_m2]`` in the
 TDM's local ENU frame (thesis eq. 3.4 without the k_lon/k_lat constants)::

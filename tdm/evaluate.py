@@ -3,7 +3,7 @@
 Reads ``RECORDING/tdm/detected_targets.jsonl`` (and ``sensor_tracks.jsonl`` when present),
 ``truth.jsonl``, ``scenario.yaml``, ``manifest.json`` and the LiDAR sweeps' ``object_id``
 (truth: evaluation only, never detection), and returns the metrics that
-``RECORDING/tdm/metrics.json`` holds (DESIGN.md, "Recording directory contract").
+``RECORDING/tdm/metrics.json`` holds (docs/contracts.md, "Recording directory").
 
 Definitions (also returned under ``"definitions"``):
 
@@ -39,12 +39,12 @@ Matching
     truth objects; pairs at ``d >= c`` are not matched (:mod:`tdm.metrics`).
 OSPA, GOSPA
     Per epoch between the in-range truth set and the reported set (:mod:`tdm.metrics`,
-    REFERENCE.md section 5; GOSPA alpha = 2); ``ospa_m`` and ``gospa_m`` are means over
+    docs/reference.md section 5; GOSPA alpha = 2); ``ospa_m`` and ``gospa_m`` are means over
     all epochs (an epoch with nothing in range and nothing reported scores 0).
 Errors
     Over matched pairs, error = target - truth: ``position_rmse_m``,
     ``median_position_error_m`` (also split by the truth object's distance from the own
-    ship: ``<=`` / ``>`` ``sensors.lidar.range_max_m``, default 100 m, REFERENCE.md section 2),
+    ship: ``<=`` / ``>`` ``sensors.lidar.range_max_m``, default 100 m, docs/reference.md section 2),
     ``sog_rmse_mps``, ``cog_rmse_deg`` (difference wrapped to [-180, 180); only pairs whose
     truth SOG > 0.5 m/s). Pairs whose reported value is null are skipped.
 Detection
@@ -105,7 +105,7 @@ from tdm.io import read_jsonl, read_manifest, read_scenario
 from tdm.metrics import DEFAULT_CUTOFF_M, DEFAULT_ORDER_P, GOSPA_ALPHA, assign_distances, distance_matrix, \
     gospa_distances, ospa_distances
 
-#: Default TDM output rate when the scenario gives none, Hz (DESIGN.md scenario example: ``tdm: {update_rate_hz: 1}``).
+#: Default TDM output rate when the scenario gives none, Hz (the default of ``tdm.update_rate_hz``, docs/scenario.md).
 DEFAULT_UPDATE_RATE_HZ = 1.0
 #: Half-width of the window about an epoch in which a LiDAR hit, or the radar's view of an object, makes it
 #: visible, s (task definition).
@@ -117,7 +117,7 @@ RADAR_VISIBLE_MIN_SPOKES = 3
 #: revolutions. A glimpse (one revolution's rays between two occlusions) cannot start a track that needs
 #: two plots, so it does not start the latency clock (docs/tdm.md).
 MIN_IN_VIEW_S = 5.0
-#: LiDAR range when the scenario gives none, m (REFERENCE.md section 2: HDL-32E returns to 100 m).
+#: LiDAR range when the scenario gives none, m (docs/reference.md section 2: HDL-32E returns to 100 m).
 DEFAULT_LIDAR_RANGE_M = 100.0
 #: Truth SOG above which an object counts as moving for the COG error, m/s (task definition).
 MOVING_SOG_MPS = 0.5
@@ -132,7 +132,7 @@ SIGNIFICANT_DIGITS = 6
 #: Keys whose floats keep more digits (latitude/longitude: 6 significant digits would be ~10 m).
 FULL_PRECISION_KEYS = frozenset({"frame_origin_lat_lon_deg"})
 FULL_PRECISION_DIGITS = 12
-#: Target descriptor expected for a truth kind (DESIGN.md detected_targets: "vessel" | "iceberg" | "unknown").
+#: Target descriptor expected for a truth kind (docs/formats.md, tdm/detected_targets.jsonl: "vessel" | "iceberg" | "unknown").
 DESCRIPTOR_OF_KIND = {"ship": "vessel", "iceberg": "iceberg"}
 #: Sensors whose in-range region the evaluation knows.
 SENSORS = ("lidar", "radar", "ais")

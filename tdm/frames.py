@@ -1,6 +1,6 @@
 """Frames of the TDM: local ENU metres, the own ship's pose over time, sensor mounts.
 
-The TDM works in its own local frame (REFERENCE.md section 5: "work in local ENU
+The TDM works in its own local frame (docs/reference.md section 5: "work in local ENU
 metres and convert to lon/lat only for output"): a transverse Mercator projection
 (WGS84, scale 1) centred on the own ship's first navigation fix, x east, y north.
 It is built from the recording alone, so it does not depend on how the recording

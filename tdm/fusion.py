@@ -1,4 +1,4 @@
-"""Track-to-track association and fusion of the per-sensor tracks (REFERENCE.md section 5).
+"""Track-to-track association and fusion of the per-sensor tracks (docs/reference.md section 5).
 
 - **Association.** A fused target holds at most one track per sensor. A track stays with its
   target while it lives and stays within the track-to-track gate; a new (or released) track

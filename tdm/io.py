@@ -1,4 +1,4 @@
-"""Readers of a recording directory (DESIGN.md "Recording directory contract").
+"""Readers of a recording directory (docs/contracts.md "Recording directory").
 
 Only the files' formats are used: these readers work on any directory laid out
 as the contract says, whoever wrote it.

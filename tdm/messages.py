@@ -1,4 +1,4 @@
-"""Detected-target messages (thesis Table 6.3; DESIGN.md recording contract) and their files.
+"""Detected-target messages (thesis Table 6.3; docs/contracts.md recording directory) and their files.
 
 One line of ``tdm/detected_targets.jsonl`` per target per output epoch::
 

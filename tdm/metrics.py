@@ -1,6 +1,6 @@
 """Distances between finite sets of 2-D positions: OSPA, GOSPA and the assignment behind them.
 
-Pure functions on ENU positions in metres (REFERENCE.md section 5, "use position-only
+Pure functions on ENU positions in metres (docs/reference.md section 5, "use position-only
 distances in metres"). ``X`` is the truth set (n, 2), ``Y`` the estimate set (m, 2).
 
 Cut-off distance ``d^(c)(x, y) = min(c, ||x - y||)``; order ``p >= 1``.
@@ -39,9 +39,9 @@ from scipy.spatial.distance import cdist
 
 #: Default cut-off distance c, metres (the evaluation's default, module ``tdm.evaluate``).
 DEFAULT_CUTOFF_M = 50.0
-#: Default order p (REFERENCE.md section 5 writes the metrics for general p; 2 is the usual choice).
+#: Default order p (docs/reference.md section 5 writes the metrics for general p; 2 is the usual choice).
 DEFAULT_ORDER_P = 2.0
-#: GOSPA alpha: 2 makes GOSPA split into localisation, missed and false terms (REFERENCE.md section 5).
+#: GOSPA alpha: 2 makes GOSPA split into localisation, missed and false terms (docs/reference.md section 5).
 GOSPA_ALPHA = 2.0
 
 

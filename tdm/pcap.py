@@ -3,7 +3,7 @@
 The file is a classic libpcap capture (any of its four magics: micro- or
 nanosecond timestamps, either byte order) of the sensor's UDP broadcast over
 Ethernet II (or Linux cooked / raw IPv4) and IPv4. Data packets go to UDP port
-2368 and are 1206 bytes long (REFERENCE.md section 2): 12 blocks of the flag
+2368 and are 1206 bytes long (docs/reference.md section 2): 12 blocks of the flag
 ``FF EE``, the block's azimuth (uint16, 0.01 deg) and 32 x (distance uint16 in
 2 mm units, reflectivity uint8); then the packet's timestamp (uint32,
 microseconds since the top of the UTC hour) and two factory bytes (return mode,
@@ -16,7 +16,7 @@ per run); only records that break a run (a position packet, a damaged record)
 are handled one by one.
 
 Each point is reconstructed as the decoders do (valgur/velodyne_decoder
-``packet_decoder.cpp``, VeloView; REFERENCE.md section 2):
+``packet_decoder.cpp``, VeloView; docs/reference.md section 2):
 
 * azimuth of firing ``j`` of a block: the block azimuth plus the packet's rotation
   rate (from its first and last block azimuths) times the firing's time offset,
@@ -56,7 +56,7 @@ from tdm.errors import RecordingError
 __all__ = ["iter_pcap_sweeps", "decode_packets", "firing_azimuths_centideg", "ELEVATION_DEG", "Z_OFFSET_M", "RING"]
 
 # ----------------------------------------------------------------------------- HDL-32E facts
-# REFERENCE.md section 2 (HDL-32E manual 63-9113; ros-drivers/velodyne 32db.yaml;
+# docs/reference.md section 2 (HDL-32E manual 63-9113; ros-drivers/velodyne 32db.yaml;
 # valgur/velodyne_decoder calib_db.cpp, packet_decoder.cpp).
 
 #: Elevation of each laser in DSR (firing / packet slot) order, degrees.
@@ -332,7 +332,7 @@ def firing_azimuths_centideg(block_az: np.ndarray, dual: np.ndarray) -> np.ndarr
 
     The rotation rate of a packet is ``wrap(az[11] - az[0]) / (t[11] - t[0])`` and firing ``j`` of
     a block lies at ``wrap(lround(block_az + rate * (t_j - t_0)))``, all in float32
-    (velodyne_decoder ``unpack_16_32_beam``; REFERENCE.md section 2).
+    (velodyne_decoder ``unpack_16_32_beam``; docs/reference.md section 2).
 
     Parameters
     ----------

@@ -316,7 +316,7 @@ def run_tdm(recording: Path, out_dir: Path | None = None, config: TdmConfig | No
     Parameters
     ----------
     recording : Path
-        A recording directory (DESIGN.md contract).
+        A recording directory (docs/contracts.md).
     out_dir : Path, optional
         Where to write; default ``RECORDING/tdm``.
     config : TdmConfig, optional

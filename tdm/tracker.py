@@ -1,4 +1,4 @@
-"""Per-sensor multi-target trackers: one EKF per sensor per target (REFERENCE.md section 5).
+"""Per-sensor multi-target trackers: one EKF per sensor per target (docs/reference.md section 5).
 
 Roles, in Stone Soup's terms:
 
@@ -302,7 +302,7 @@ class PositionTracker:
 class AisTrackerConfig:
     """AIS tracking parameters.
 
-    The measurement noise is the thesis's AIS noise model (REFERENCE.md section 4 / the
+    The measurement noise is the thesis's AIS noise model (docs/reference.md section 4 / the
     thesis's ``AIS_*`` parameters): position variance 5 + 0.5 m^2 (white + bias), COG 1 + 0.5
     deg^2, SOG 0.5 + 0.1 kn^2, ROT 2000 + 500 (deg/min)^2. These are what the TDM assumes of any
     transponder; they are not read from the recording.

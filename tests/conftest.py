@@ -9,7 +9,7 @@ import yaml
 
 REPO = Path(__file__).resolve().parents[1]
 
-#: A small valid scenario (the DESIGN.md example, shortened).
+#: A small valid scenario (the example scenario of docs/contracts.md, shortened).
 BASE = {
     "name": "small",
     "start_time": "2017-06-01T12:00:00Z",

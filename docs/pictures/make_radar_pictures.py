@@ -4,7 +4,7 @@
 
 Writes ``<name>_ppi_calm.png`` (sea state 1, no rain), ``<name>_ppi_ss5.png`` (sea state 5,
 16 m/s wind) and ``<name>_ppi_rain.png`` (sea state 3 with 16 mm/h rain, an IMO test case,
-REFERENCE.md section 3) next to this script. Each is the renderer's own north-up PPI of the
+docs/reference.md section 3) next to this script. Each is the renderer's own north-up PPI of the
 revolution starting at ``--time``, sea control (STC) at its default, rain control off.
 """
 

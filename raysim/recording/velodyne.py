@@ -1,4 +1,4 @@
-"""Velodyne HDL-32E packets and their PCAP file (REFERENCE.md section 2).
+"""Velodyne HDL-32E packets and their PCAP file (docs/reference.md section 2).
 
 Data packets (UDP 2368, 1206 bytes, little-endian): 12 blocks of ``FF EE``,
 azimuth (0.01 deg), 32 x (distance in 2 mm, reflectivity); then the timestamp

@@ -1,7 +1,7 @@
 """AIS message fields from physical values: units, legal ranges, "not available" codes (ITU-R M.1371).
 
 pyais encodes what it is given and wraps silently outside a field's range (ROT 800 deg/min
-becomes a left turn, SOG 150 kn becomes 47.6 kn, heading 600 becomes 88: REFERENCE.md
+becomes a left turn, SOG 150 kn becomes 47.6 kn, heading 600 becomes 88: docs/reference.md
 section 4), so every value is clamped here first; NaN means "not available".
 
 ROT uses the standard encoding ``ROT_AIS = round(4.733 sqrt(|ROT|))`` (deg/min, sign kept),

@@ -1,6 +1,6 @@
 """When AIS transponders transmit: ITU-R M.1371 reporting intervals, slots, channels, jitter.
 
-REFERENCE.md section 4. Class A position reports (types 1/3): at anchor or moored and under
+docs/reference.md section 4. Class A position reports (types 1/3): at anchor or moored and under
 3 kn every 3 min; 0-14 kn every 10 s (3 1/3 s while changing course); 14-23 kn every 6 s (2 s
 while changing course); over 23 kn every 2 s. Static and voyage data (type 5) at start and
 every 6 min. Class B "CS" (type 18): every 30 s above 2 kn, every 3 min at or below; static data

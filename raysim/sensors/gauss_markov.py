@@ -1,6 +1,6 @@
 """White noise plus a first-order Gauss-Markov bias at irregular times (the thesis's error model).
 
-REFERENCE.md section 4 (thesis section 2.5, eq. 2.1-2.3): a measured quantity is
+docs/reference.md section 4 (thesis section 2.5, eq. 2.1-2.3): a measured quantity is
 ``x_m = x + b + w_m`` with white noise ``w_m ~ N(0, sigma_w^2)`` and a bias
 ``db/dt = -b / T_b + w_b``. Discretised exactly between two times ``dt`` apart::
 

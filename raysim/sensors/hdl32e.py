@@ -1,6 +1,6 @@
 """Velodyne HDL-32E facts: lasers, firing schedule, packet azimuths, beam geometry.
 
-Everything here comes from REFERENCE.md section 2 (HDL-32E user manual 63-9113,
+Everything here comes from docs/reference.md section 2 (HDL-32E user manual 63-9113,
 ros-drivers/velodyne ``32db.yaml``, valgur/velodyne_decoder ``calib_db.cpp`` and
 ``packet_decoder.cpp``). The functions are pure and vectorised over firing cycles.
 
@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 #: Laser table in DSR (firing / packet slot) order: elevation (deg) and vertical origin offset (m).
-#: REFERENCE.md section 2 table (velodyne_decoder calib_db.cpp, ros-drivers 32db.yaml).
+#: docs/reference.md section 2 table (velodyne_decoder calib_db.cpp, ros-drivers 32db.yaml).
 ELEVATION_DEG = np.array([
     -30.67, -9.33, -29.33, -8.00, -28.00, -6.67, -26.67, -5.33, -25.33, -4.00, -24.00, -2.67, -22.67, -1.33, -21.33, 0.00,
     -20.00, 1.33, -18.67, 2.67, -17.33, 4.00, -16.00, 5.33, -14.67, 6.67, -13.33, 8.00, -12.00, 9.33, -10.67, 10.67,

@@ -15,7 +15,7 @@ All of it is vectorised over firings; every constant is a parameter with its sou
   gets one with probability ``1 - exp(-alpha L)`` (L = 10 m window), at a range
   drawn from an exponential of mean 3 m beyond the minimum range, with backscatter
   reflectance 0.02 (engineering values, unverified).
-- Reflectivity byte (firmware >= 2.0, REFERENCE.md section 2): diffuse surfaces
+- Reflectivity byte (firmware >= 2.0, docs/reference.md section 2): diffuse surfaces
   0..100 = 100 x the apparent reflectance ``rho cos(theta)``; retro-reflectors
   101..255, growing with ``cos(theta)``.
 """

@@ -1,6 +1,6 @@
 """Marine X-band radar physics: pure, vectorised functions (no rendering, no I/O).
 
-Every figure comes from /work/shared/REFERENCE.md section 3 (cited by item number as
+Every figure comes from docs/reference.md section 3 (cited by item number as
 "REF 3.n") unless marked "(unverified)": those are engineering defaults, kept as named
 parameters so that a measured value can replace them.
 

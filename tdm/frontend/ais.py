@@ -1,7 +1,7 @@
 r"""AIS front end: ``ais/ais.nmea`` to position reports in ENU and static data per MMSI.
 
 Each line of the file is an ``!AIVDM`` sentence prefixed by an NMEA 4.10 TAG block
-carrying its reception time, ``\c:<unix s>*hh\!AIVDM,...*hh`` (REFERENCE.md section 4).
+carrying its reception time, ``\c:<unix s>*hh\!AIVDM,...*hh`` (docs/reference.md section 4).
 Sentences are parsed with pyais (``NMEASentenceFactory``; multi-sentence messages joined
 with ``NMEAMessage.assemble_from_iterable``), so any receiver's log in that form reads.
 
@@ -21,7 +21,7 @@ starting with ``"ais/nmea: "`` and the line or message is skipped):
 * ``!AIVDO`` sentences (the own ship's transponder) are not targets: skipped, not counted.
 * Types 1, 2, 3 (Class A), 18 and 19 (Class B) give an :class:`AisReport`; types 5, 19
   and 24 (parts A and B) fill an :class:`AisStatic` per MMSI (later messages update it).
-* Units: SOG knots -> m/s (1 kn = 1852/3600 m/s, REFERENCE.md section 1); SOG 102.3
+* Units: SOG knots -> m/s (1 kn = 1852/3600 m/s, docs/reference.md section 1); SOG 102.3
   (1023), COG 360 (3600) and heading 511 mean not available -> NaN.
 * ROT: decoded from the raw indicator bits (pyais rounds its deg/min to whole degrees):
   ``ROT = sign(k) (k / 4.733)^2`` deg/min (ITU-R M.1371: ``k = 4.733 sqrt(ROT)``, sign
@@ -49,8 +49,8 @@ from tdm.frames import EnuFrame
 
 __all__ = ["read_ais", "rot_deg_per_min", "MPS_PER_KNOT"]
 
-MPS_PER_KNOT = 1852.0 / 3600.0  # REFERENCE.md section 1
-ROT_SCALE = 4.733  # ITU-R M.1371 ROT indicator: k = 4.733 sqrt(ROT deg/min) (REFERENCE.md section 4)
+MPS_PER_KNOT = 1852.0 / 3600.0  # docs/reference.md section 1
+ROT_SCALE = 4.733  # ITU-R M.1371 ROT indicator: k = 4.733 sqrt(ROT deg/min) (docs/reference.md section 4)
 ROT_NOT_AVAILABLE = -128
 ROT_NO_INDICATOR = 127  # +-127: turning at more than 5 deg / 30 s, no turn indicator
 ROT_BIT, ROT_WIDTH = 42, 8  # types 1-3: signed 8-bit ROT indicator at bit 42 (gpsd AIVDM)

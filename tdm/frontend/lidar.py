@@ -5,7 +5,7 @@ Steps (all vectorised; the only Python loop is over ring offsets):
 1. **Own ship.** ~85 % of a sweep's points hit the own ship. They are dropped first and
    cheaply by a box test in the body frame (sensor points moved by the mount): a vertical
    column ``|x - ownship_centre_x_m| <= length/2 + margin``, ``|y| <= beam/2 + margin``.
-   The column is unbounded in z: the HDL-32E looks at most 10.67 deg up (REFERENCE.md
+   The column is unbounded in z: the HDL-32E looks at most 10.67 deg up (docs/reference.md
    section 2), so nothing but the own ship can be inside it.
 2. **Bad returns.** Non-finite points and ranges outside ``[range_min_m, range_max_m]``
    (0 = no return in the Velodyne encoding) are dropped.
@@ -96,7 +96,7 @@ from scipy.spatial import cKDTree
 from tdm.detections import Detections
 from tdm.frames import Mount, OwnshipTrack
 
-#: HDL-32E firing cycle: 32 firings of 1.152 us + 9.216 us recharge, s (REFERENCE.md section 2).
+#: HDL-32E firing cycle: 32 firings of 1.152 us + 9.216 us recharge, s (docs/reference.md section 2).
 HDL32E_FIRING_CYCLE_S = 46.08e-6
 #: Range-image neighbours lie at most two azimuth steps (firing cycles) apart, so they are fired
 #: within this many cycles of each other; points a revolution apart (at the seam) are not linked.
@@ -111,7 +111,7 @@ class LidarFrontEndConfig:
     ----------
     ownship_length_m, ownship_beam_m : float
         Own ship's length overall and beam, m. Default: Odin, the thesis's USV (10.9 x 3.5 m,
-        DESIGN.md scenario example).
+        scenarios/busy_open_sea.yaml).
     ownship_margin_m : float
         Padding of the own-ship box on every side, m (default 0.5: covers fenders, rails and
         the range noise; nothing nearer than that to the hull is a target to track).
@@ -120,7 +120,7 @@ class LidarFrontEndConfig:
         recordings' meshes).
     range_min_m, range_max_m : float
         Returns outside this range are dropped, m. Defaults: 0.1 m (drivers cut at 0.1-0.9 m)
-        and 100 m (HDL-32E rated range), REFERENCE.md section 2.
+        and 100 m (HDL-32E rated range), docs/reference.md section 2.
     min_height_m : float
         Points whose ENU z is below this are sea or foam, m. The sea surface is the plane
         z = 0 (waves move the own ship, not the sea's returns), and foam returns lie within
@@ -132,7 +132,7 @@ class LidarFrontEndConfig:
         a voxel while a close iceberg's ~2000 points become a few hundred voxels.
     cluster_tolerance_m : float
         Euclidean clustering distance on the horizontal plane, m (PCL/Autoware default 0.7 m,
-        REFERENCE.md section 5).
+        docs/reference.md section 5).
     ring_link_angle_deg : float
         Minimum angle beta for joining points of nearby rings, deg (10 deg: Bogoslavskyi &
         Stachniss 2016, the depth_clustering default).
@@ -140,23 +140,23 @@ class LidarFrontEndConfig:
         Rings up to this many apart are linked (2: bridges one ring without a return).
     min_points, max_points : int, int or None
         Clusters with fewer (more) raw points are dropped. 10 is the PCL/Autoware minimum
-        (REFERENCE.md section 5, counted there on voxels). No maximum by default: the
+        (docs/reference.md section 5, counted there on voxels). No maximum by default: the
         Autoware maximum of 1000 removes buildings on land, but at sea a big cluster is a big
         target (a close iceberg gives ~2000 points).
     min_surface_fraction : float
         Clusters in which fewer than this fraction of the points have a same-surface
         neighbour along their own ring are dropped as weather. A solid surface is hit by
-        successive firings of a laser; backscatter from rain and fog drops (REFERENCE.md
+        successive firings of a laser; backscatter from rain and fog drops (docs/reference.md
         section 2) is not: measured here, 0-3 % of the points of rain clusters
         (rough_sea_rain) against 92-100 % of those of iceberg and ship clusters. 0.5 lies
         well between.
     range_sigma_m : float
-        Range accuracy, 1 sigma, m (HDL-32E: < 2 cm at 25 m, REFERENCE.md section 2, unverified).
+        Range accuracy, 1 sigma, m (HDL-32E: < 2 cm at 25 m, docs/reference.md section 2, unverified).
     rotation_hz : float
         Head rotation rate, Hz (HDL-32E default 10 Hz); sets the azimuth step.
     beam_divergence_mrad : float
         Full beam divergence, mrad (no official HDL-32E figure; simulators use about 3 mrad,
-        REFERENCE.md section 2).
+        docs/reference.md section 2).
     nav_position_sigma_m : float
         Own-ship position error, 1 sigma per axis, m (GNSS noise and bias; default 0.5 m, a
         typical uncorrected GNSS fix, unverified; :meth:`from_scenario` reads the recording's).

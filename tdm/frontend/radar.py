@@ -2,7 +2,7 @@
 
 Steps (numpy/scipy-vectorised; Python loops only over chunks of cells):
 
-1. Video to power (:func:`video_power`). A sweep holds 4-bit *log* video levels (REFERENCE.md
+1. Video to power (:func:`video_power`). A sweep holds 4-bit *log* video levels (docs/reference.md
    3.10: ``v = clip(floor((P_dB - floor_dB) / step_dB), 0, 15)``), while the CFAR thresholds assume
    a square-law (linear power) detector. So each level reads as the power at the centre of its bin,
    in units of the mean thermal noise: ``P(v) = 10^((video_threshold_db + video_step_db (v - 1/2))
@@ -12,7 +12,7 @@ Steps (numpy/scipy-vectorised; Python loops only over chunks of cells):
    defaults (level 1 starts 9.6 dB over the noise mean; OS alpha 9.3 dB) a non-zero cell in a
    zero background passes, so on thermal noise the false-alarm rate is the receiver's own
    first-level crossing probability, ``exp(-10^0.96) = 1.1e-4``, the IMO basis ``Pfa = 1e-4``
-   (REFERENCE.md 3 table) the first level is set for. Floating-point input (synthetic tests) is
+   (docs/reference.md section 3 table) the first level is set for. Floating-point input (synthetic tests) is
    linear power as it is, with no floor.
 
 2. CFAR along range (:func:`cfar_mask`), every spoke. The training cells of a cell under test (CUT)
@@ -21,8 +21,8 @@ Steps (numpy/scipy-vectorised; Python loops only over chunks of cells):
    window slides inwards, so every CUT keeps N training cells.
 
    - CA (cell averaging): ``T = alpha mean(training)``, ``alpha = N (Pfa^(-1/N) - 1)`` (exact on
-     exponential noise, REFERENCE.md 5).
-   - OS (ordered statistic, Rohling 1983; REFERENCE.md 5: k about 3N/4, robust at clutter edges
+     exponential noise, docs/reference.md section 5).
+   - OS (ordered statistic, Rohling 1983; docs/reference.md section 5: k about 3N/4, robust at clutter edges
      and next to other targets): ``T = alpha X_(k)``, X_(k) the k-th smallest training value, alpha
      from ``Pfa = prod_{i=0}^{k-1} (N - i) / (N - i + alpha)`` (exponential noise). On video levels
      the test needs no sort: ``P(CUT) > alpha P(X_(k))`` holds exactly when fewer than ``N - k + 1``
@@ -46,7 +46,7 @@ Steps (numpy/scipy-vectorised; Python loops only over chunks of cells):
 
 5. Clutter map (:func:`clutter_map`): one-dimensional CFAR cannot tell sea clutter from targets on
    4-bit video. Sea clutter is mostly below level 1, so its training estimates sit on the floor,
-   while its K-distributed spikes (REFERENCE.md 3.8) cross the first levels in patches the size of a
+   while its K-distributed spikes (docs/reference.md 3.8) cross the first levels in patches the size of a
    beam and a wave. A plot is kept only if its peak *beam-integrated* power
    (:func:`beam_integrated_power`: the spokes of about half a beam averaged, which lowers the sea's
    spoke-to-spoke speckle and not a target's steady echo) exceeds the local clutter level by
@@ -85,7 +85,7 @@ __all__ = ["RadarFrontEndConfig", "beam_integrated_power", "ca_alpha", "cfar_mas
            "label_plots", "mount_from_scenario", "os_alpha", "radar_detections", "training_table", "video_power",
            "video_power_table"]
 
-#: Levels of the 4-bit video (REFERENCE.md 3 table: "1024 samples, 4 bits each (0..15)").
+#: Levels of the 4-bit video (docs/reference.md section 3 table: "1024 samples, 4 bits each (0..15)").
 VIDEO_LEVELS = 16
 
 
@@ -101,18 +101,18 @@ class RadarFrontEndConfig:
     ----------
     cfar : str
         ``"os"`` (ordered statistic, default: robust at clutter edges and next to other targets,
-        REFERENCE.md 5) or ``"ca"`` (cell averaging).
+        docs/reference.md section 5) or ``"ca"`` (cell averaging).
     pfa : float
         Design false-alarm probability per cell on exponential noise. Default 1e-4, the IMO
-        detection basis (REFERENCE.md 3 table).
+        detection basis (docs/reference.md section 3 table).
     training_cells : int
         N, training cells per CUT in all (N/2 each side in the interior). Default 32 (29 m each side
-        at 1.81 m samples: longer than a sea-clutter patch, REFERENCE.md 3.8).
+        at 1.81 m samples: longer than a sea-clutter patch, docs/reference.md 3.8).
     guard_cells : int
         G, guard cells each side of the CUT, not trained on. Default 4 (7 m: the 2.5 m range
-        point-spread of REFERENCE.md 3.3 with margin).
+        point-spread of docs/reference.md 3.3 with margin).
     os_rank : int or None
-        k of OS-CFAR (1-based). None: ``round(3 N / 4)`` (REFERENCE.md 5).
+        k of OS-CFAR (1-based). None: ``round(3 N / 4)`` (docs/reference.md section 5).
     min_echo_level : int
         Lowest video level a detection may have. Default 1 (anything over the receiver's floor).
     fill_level : int
@@ -121,10 +121,10 @@ class RadarFrontEndConfig:
     video_threshold_db : float
         Power where video level 1 starts, dB over the mean thermal noise. Default 9.6 dB, the level
         noise alone crosses with probability 1e-4 (``10 log10(-ln 1e-4)``; the IMO Pfa,
-        REFERENCE.md 3 table); a receiver sets its floor so (REFERENCE.md 3.10). Unverified for a
+        docs/reference.md section 3 table); a receiver sets its floor so (docs/reference.md 3.10). Unverified for a
         real set, whose gain control moves it.
     video_step_db : float
-        dB per video level (log video, REFERENCE.md 3.10). Default 3 dB (16 levels over 45 dB;
+        dB per video level (log video, docs/reference.md 3.10). Default 3 dB (16 levels over 45 dB;
         unverified for a real set).
     integration_spokes : int
         Spokes averaged for the seed test (step 5). Default 16 (2.8 deg, about half the 5.2 deg
@@ -135,7 +135,7 @@ class RadarFrontEndConfig:
         Clutter-map annulus, blocks (azimuth, range): the window minus its central guard. Defaults
         (65, 5) minus (5, 3): 183 deg x 72 m minus 14 deg x 43 m. Wide in azimuth, so that targets
         fill few of its 310 blocks; narrow in range, to follow the clutter's fall with range and
-        the sensitivity-time control's rise near the antenna (REFERENCE.md 3.10). On rendered
+        the sensitivity-time control's rise near the antenna (docs/reference.md 3.10). On rendered
         sea states 2 and 4 it found more targets at fewer false plots than (33, 9).
     clutter_quantile : float
         Quantile of the annulus's block maxima taken as the local clutter level. Default 0.9
@@ -160,10 +160,10 @@ class RadarFrontEndConfig:
         Margin about the hull inside which plots are the own ship, metres. Default 5 m (two range
         resolutions).
     beam_az_deg : float
-        -3 dB one-way horizontal beamwidth, deg. Default 5.2 (REFERENCE.md 3 table).
+        -3 dB one-way horizontal beamwidth, deg. Default 5.2 (docs/reference.md section 3 table).
     range_resolution_m : float
         Physical range resolution (FMCW bandwidth or pulse length, ``c / (2 B)``), metres.
-        Default 2.5 (REFERENCE.md 3.3: about 2-3 m).
+        Default 2.5 (docs/reference.md 3.3: about 2-3 m).
     blanking_m : float
         Main-bang blanking: nearer samples hold no data and are not training cells, metres.
         Default 3 (scenario ``sensors.radar.blanking_m``).
@@ -282,7 +282,7 @@ def mount_from_scenario(scenario: dict) -> Mount:
 
 
 def ca_alpha(n_training: int, pfa: float) -> float:
-    """CA-CFAR multiplier ``alpha = N (Pfa^(-1/N) - 1)`` (exponential noise; REFERENCE.md 5)."""
+    """CA-CFAR multiplier ``alpha = N (Pfa^(-1/N) - 1)`` (exponential noise; docs/reference.md section 5)."""
     return float(n_training * (pfa ** (-1.0 / n_training) - 1.0))
 
 
@@ -651,7 +651,7 @@ def beam_integrated_power(power: np.ndarray, config: RadarFrontEndConfig) -> tup
     Spokes are summed in groups of ``g = integration_spokes / 2`` (a divisor of the spoke count) and
     two neighbouring groups make one window: row i is the mean of spokes ``g i .. g i + 2 g - 1``
     (circular), every sample. A target's echo holds over the beam while the sea's speckle changes
-    from spoke to spoke (REFERENCE.md 3.8), so this non-coherent integration lowers the clutter's
+    from spoke to spoke (docs/reference.md 3.8), so this non-coherent integration lowers the clutter's
     spikes, not the target. Decimating by g (1.4 deg at 2048 spokes) costs a target's peak at most
     0.5 dB in a 5.2 deg two-way Gaussian beam.
 
@@ -853,7 +853,7 @@ def radar_detections(sweep: dict, track: OwnshipTrack, mount: Mount, config: Rad
           ``res`` between the plot's strongest and weakest cells;
         - cross-range extent ``Lc = r max(extent_az - s_az, d_az)`` (radians), with
           ``s_az = theta3 sqrt(log2(P_max / P_min) / 2)`` the same for the two-way Gaussian beam
-          ``exp(-8 ln2 theta^2 / theta3^2)`` (REFERENCE.md 3.2) and ``d_az`` one spoke: the beam's
+          ``exp(-8 ln2 theta^2 / theta3^2)`` (docs/reference.md 3.2) and ``d_az`` one spoke: the beam's
           smear is taken off, so a point target is about one cell and a ship its own size;
         - ``beam_fill = extent_az / max(s_az, d_az)``: a point echo paints at least the beam's
           ``s_az``, so a plot with a fill well under 1 is narrower than anything received through

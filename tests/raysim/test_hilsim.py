@@ -14,7 +14,7 @@ from raysim.hilsim import import_hilsim
 from raysim.scenario import load_scenario
 from tests.conftest import REPO
 
-# A copy of ../shared/hilsim_busy_open_sea (the thesis's appendix B files), so these tests never skip.
+# The thesis's busy-open-sea configuration files (its appendix B, Listings B.1-B.3), kept here so these tests never skip.
 THESIS = REPO / "tests" / "data" / "hilsim_busy_open_sea"
 FILES = [THESIS / "obstacle_params.yaml", THESIS / "sensor_params.yaml", THESIS / "dynamics_params.yaml"]
 

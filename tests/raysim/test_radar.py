@@ -118,7 +118,7 @@ def test_sea_clutter_falls_with_range_rises_with_sea_state_and_is_absent_behind_
 def test_nrl_level_of_the_clutter_for_a_clean_geometry(tmp_path):
     renderer, _ = radar_world(tmp_path, environment={"sea_state": 3, "wind_speed_mps": 7}, name="nrl")
     # at the range where the grazing angle is 1 deg, the model's mean equals the NRL reference value
-    # (-43.7 dB, REFERENCE.md) x cell area R theta dR sec(psi) through the radar equation, all written out here
+    # (-43.7 dB, docs/reference.md 3.7) x cell area R theta dR sec(psi) through the radar equation, all written out here
     r = np.asarray(renderer.range_m, dtype=float)
     re = 4.0 / 3.0 * 6_371_000.0
     with np.errstate(divide="ignore", invalid="ignore"):

@@ -23,7 +23,7 @@ from tests.conftest import BASE
 from tests.tdm.conftest import render_recording
 
 LAT0, LON0 = BASE["origin"]["lat"], BASE["origin"]["lon"]
-ELEVATIONS_DEG = -30.67 + 4.0 / 3.0 * np.arange(32)  # HDL-32E rings, REFERENCE.md section 2
+ELEVATIONS_DEG = -30.67 + 4.0 / 3.0 * np.arange(32)  # HDL-32E rings, docs/reference.md section 2
 MOUNT_Z_M = 3.0
 MOUNT = Mount(z_m=MOUNT_Z_M)
 

@@ -24,7 +24,7 @@ from tests.tdm.conftest import render_recording
 
 LAT0, LON0 = BASE["origin"]["lat"], BASE["origin"]["lon"]
 SPOKES, SAMPLES, RANGE_SCALE_M = 2048, 1024, 1852.0
-RANGE_M = np.linspace(0.0, RANGE_SCALE_M, SAMPLES)  # the recording's sample ranges (REFERENCE.md 3 table)
+RANGE_M = np.linspace(0.0, RANGE_SCALE_M, SAMPLES)  # the recording's sample ranges (docs/reference.md section 3 table)
 
 
 # ------------------------------------------------------------------ CFAR on synthetic noise
@@ -37,7 +37,7 @@ def test_cfar_multipliers_meet_their_false_alarm_formulas():
     pfa = np.prod([(32 - i) / (32 - i + alpha) for i in range(24)])
     assert pfa == pytest.approx(1e-4, rel=1e-6)
     assert os_alpha(32, 24, 1e-3) < alpha  # a looser Pfa, a lower threshold
-    assert RadarFrontEndConfig().rank == 24  # 3N/4, REFERENCE.md 5
+    assert RadarFrontEndConfig().rank == 24  # 3N/4, docs/reference.md section 5
 
 
 @pytest.mark.parametrize("kind", ["ca", "os"])
@@ -77,7 +77,7 @@ def test_os_finds_a_target_next_to_a_clutter_edge_where_ca_is_masked():
 
 
 def test_zero_video_floor_gives_the_receivers_first_level_false_alarm_rate():
-    # thermal noise through the receiver model of REFERENCE.md 3.10: level v = floor((P_dB - 6.6) / 3)
+    # thermal noise through the receiver model of docs/reference.md 3.10: level v = floor((P_dB - 6.6) / 3)
     power_db = 10 * np.log10(np.random.default_rng(4).standard_exponential((SPOKES, SAMPLES)))
     echo = np.clip(np.floor((power_db - 6.6) / 3.0), 0, 15).astype(np.uint8)
     config = RadarFrontEndConfig()
@@ -161,7 +161,7 @@ def sweep_with(blobs=(), points=(), heading_deg: float = 0.0) -> dict[str, np.nd
 
     ``blobs``: ``(first_spoke, n_spokes, first_sample, n_samples, level)``. ``points``:
     ``(spoke, sample, peak_level)``, the echo of a point target through the 5.2 deg two-way Gaussian
-    beam and a 2.5 m Gaussian range point-spread (REFERENCE.md 3.2, 3.3), 3 dB per level.
+    beam and a 2.5 m Gaussian range point-spread (docs/reference.md 3.2, 3.3), 3 dB per level.
     """
     echo = np.zeros((SPOKES, SAMPLES), dtype=np.uint8)
     for spoke0, n_spokes, sample0, n_samples, level in blobs:
