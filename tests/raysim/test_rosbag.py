@@ -208,3 +208,18 @@ def test_bag_radar_picture_and_truth_labels_and_geojson(recording):
         lon, lat = feature["geometry"]["coordinates"]
         row = at_one[feature["properties"]["name"]]
         assert (lon, lat) == pytest.approx((row["lon"], row["lat"]), abs=1e-8)
+
+
+def test_the_foxglove_layout_names_topics_the_bag_has(recording):
+    """docs/foxglove_layout.json opens a recording: every topic it names is in the bag (TDM topics after raysim run)."""
+    layout = json.loads((REPO / "docs" / "foxglove_layout.json").read_text())
+    panels = layout["configById"]
+    assert {key.split("!")[0] for key in panels} == {"3D", "Map", "Image", "Plot"}
+    named = set(panels["3D!raysim3d"]["topics"]) | set(panels["Map!raysimmap"]["topicColors"])
+    named |= {panels["Map!raysimmap"]["followTopic"], panels["Image!raysimppi"]["imageMode"]["imageTopic"]}
+    named |= {p["value"].split(".")[0] for p in panels["Plot!raysimplot"]["paths"]}
+    bag = set(messages(recording))
+    tdm_topics = {"/tdm/detected_targets", "/tdm/markers", "/tdm/detections", "/tdm/geojson"}
+    assert {t for t in named if not t.startswith("/tdm/")} <= bag
+    assert {t for t in named if t.startswith("/tdm/")} <= tdm_topics
+    assert panels["3D!raysim3d"]["followTf"] == "base_link"
