@@ -1,4 +1,4 @@
-"""Scenario files: the native YAML format of DESIGN.md, loaded strictly into typed objects.
+"""Scenario files: the native YAML format of docs/scenario.md, loaded strictly into typed objects.
 
 ``load_scenario(path)`` parses with ``yaml.safe_load`` only, validates every key
 (unknown keys, wrong types, NaN/inf and out-of-range values are errors naming the
@@ -246,6 +246,9 @@ class Nav:
     heading_bias_deg: float = param(0.1, doc="Heading Gauss-Markov bias, standard deviation, deg", ge=0, le=10)
     heading_bias_time_constant_s: float = param(600.0, doc="Time constant of the heading bias, s", gt=0)
     attitude_noise_deg: float = param(0.02, doc="Roll and pitch white noise, standard deviation, deg", ge=0, le=10)
+    geoid_separation_m: float = param(0.0, doc="EGM96 geoid height above the WGS84 ellipsoid at the scenario area, m: "
+                                      "the GGA geoid separation field; the ellipsoidal altitude that receivers "
+                                      "report is the GGA altitude plus this", ge=-120, le=120)
 
 
 @dataclass(frozen=True, kw_only=True)

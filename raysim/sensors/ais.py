@@ -1,6 +1,6 @@
 """AIS traffic as the own ship's receiver hears it: ``ais/ais.nmea``.
 
-For every ship with an enabled transponder (REFERENCE.md section 4):
+For every ship with an enabled transponder (docs/reference.md section 4):
 
 1. Kinematics on a 0.5 s grid from its motion: SOG, COG, true heading and the rate of turn
    (deg/min, from the heading's time derivative).
@@ -21,12 +21,17 @@ For every ship with an enabled transponder (REFERENCE.md section 4):
    (4/3 earth) of the own ship at the time is received.
 5. Output: every received message as ``!AIVDM`` sentences (pyais), each line prefixed by an NMEA
    4.10 TAG block with its reception time ``\\c:<unix s>*hh\\``; multi-sentence messages (type 5)
-   carry a sequential message id 0..9. Lines are in time order; the file is deterministic.
+   carry a sequential message id 0..9. Lines are in time order; the file is deterministic. In the
+   same pass: ``ais/ais_plain.nmea``, the same sentences without TAG blocks and with CR LF line ends
+   (what a chart plotter's serial or UDP input sees), and ``ais/ais_received.jsonl``, one
+   ``{"t": <reception time, s since start>, "sentence": ...}`` per line of ``ais/ais.nmea``, in its
+   order (the TAG block keeps only whole seconds).
 """
 
 from __future__ import annotations
 
 import datetime as dt
+import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -43,7 +48,8 @@ from raysim.sensors import ais_fields as fields
 from raysim.sensors import ais_schedule as schedule
 from raysim.sensors.gauss_markov import white_plus_bias
 
-__all__ = ["AisMessage", "ship_messages", "received_messages", "ais_lines", "render_ais", "radio_horizon_m"]
+__all__ = ["AisMessage", "ship_messages", "received_messages", "ais_sentences", "ais_lines", "write_ais_files",
+           "render_ais", "radio_horizon_m"]
 
 KNOTS_PER_MPS = 3600.0 / 1852.0
 GRID_S = 0.5  # kinematics grid (finer than the 2 s shortest interval)
@@ -189,22 +195,78 @@ def received_messages(world, messages: list[AisMessage], obj) -> list[AisMessage
     return [m for m, k in zip(messages, keep) if k]
 
 
-def ais_lines(messages: list[AisMessage], start_time: dt.datetime) -> list[str]:
-    """NMEA lines of the messages in time order: TAG block + ``!AIVDM`` sentence; seq ids 0..9 for multi-part."""
+def ais_sentences(messages: list[AisMessage]) -> list[tuple[float, str]]:
+    """The ``!AIVDM`` sentences of the messages in time order, with their reception times.
+
+    Parameters
+    ----------
+    messages : list of AisMessage
+        Received messages, any order.
+
+    Returns
+    -------
+    list of (float, str)
+        ``(t_s, sentence)``: reception time, s since the scenario start, and the sentence with its
+        checksum; ordered by time, MMSI and message type; the fragments of a multi-sentence message
+        are consecutive, share its time and a sequential message id 0..9.
+    """
     order = sorted(messages, key=lambda m: (m.t_s, m.mmsi, m.data["msg_type"]))
-    base = start_time.timestamp()
-    lines, seq = [], 0
+    out, seq = [], 0
     for m in order:
         sentences = encode_dict(m.data, talker_id="AI", sentence_type="VDM", radio_channel=m.channel, seq_id=seq)
         if len(sentences) > 1:
             seq = (seq + 1) % 10
-        tag = tag_block(base + m.t_s)
-        lines += [tag + s for s in sentences]
-    return lines
+        out += [(m.t_s, s) for s in sentences]
+    return out
+
+
+def ais_lines(messages: list[AisMessage], start_time: dt.datetime) -> list[str]:
+    """NMEA lines of the messages in time order: TAG block + ``!AIVDM`` sentence; seq ids 0..9 for multi-part."""
+    base = start_time.timestamp()
+    return [tag_block(base + t_s) + s for t_s, s in ais_sentences(messages)]
+
+
+def write_ais_files(directory: Path, messages: list[AisMessage], start_time: dt.datetime) -> int:
+    r"""Write ``ais.nmea``, ``ais_plain.nmea`` and ``ais_received.jsonl`` into ``directory`` in one pass.
+
+    Parameters
+    ----------
+    directory : Path
+        The recording's ``ais`` directory (created if missing).
+    messages : list of AisMessage
+        The received messages.
+    start_time : datetime.datetime
+        Scenario start, UTC (the TAG blocks' UNIX seconds).
+
+    Returns
+    -------
+    int
+        Number of sentences: the line count of each of the three files.
+
+    Notes
+    -----
+    Line k of each file is the same sentence: in ``ais.nmea`` behind its TAG block (``\n``), in
+    ``ais_plain.nmea`` alone (CR LF, as NMEA 0183 on the wire), in ``ais_received.jsonl`` as
+    ``{"t": <s since start, 6 decimals>, "sentence": ...}``.
+    """
+    directory = Path(directory)
+    base = start_time.timestamp()
+    n = 0
+    with atomic_path(directory / "ais.nmea") as tagged_tmp, atomic_path(directory / "ais_plain.nmea") as plain_tmp, \
+            atomic_path(directory / "ais_received.jsonl") as times_tmp, \
+            open(tagged_tmp, "w", encoding="ascii", newline="\n") as tagged, \
+            open(plain_tmp, "w", encoding="ascii", newline="\n") as plain, \
+            open(times_tmp, "w", encoding="ascii", newline="\n") as times:
+        for t_s, s in ais_sentences(messages):
+            tagged.write(tag_block(base + t_s) + s + "\n")
+            plain.write(s + "\r\n")
+            times.write(f'{{"t": {t_s:.6f}, "sentence": {json.dumps(s)}}}\n')
+            n += 1
+    return n
 
 
 def render_ais(ctx) -> None:
-    """The ``ais`` entry for :data:`raysim.render.SENSOR_RENDERERS`: writes ``ais/ais.nmea``."""
+    """The ``ais`` entry for :data:`raysim.render.SENSOR_RENDERERS`: writes ``ais/`` (:func:`write_ais_files`)."""
     world = ctx.world
     ships = {ship.name: ship for ship in world.scenario.ships}
     received, transmitted = [], 0
@@ -214,11 +276,8 @@ def render_ais(ctx) -> None:
         sent = ship_messages(world, obj, ships[obj.name])
         transmitted += len(sent)
         received += received_messages(world, sent, obj)
-    lines = ais_lines(received, world.scenario.start_time)
-    path = Path(ctx.out_dir) / "ais" / "ais.nmea"
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_path(path) as tmp:
-        tmp.write_text("".join(line + "\n" for line in lines), encoding="ascii", newline="\n")
-    ctx.counts["ais/ais.nmea"] = len(lines)
+    lines = write_ais_files(Path(ctx.out_dir) / "ais", received, world.scenario.start_time)
+    for name in ("ais.nmea", "ais_plain.nmea", "ais_received.jsonl"):
+        ctx.counts[f"ais/{name}"] = lines
     ctx.counts["ais/messages_transmitted"] = transmitted
     ctx.counts["ais/messages_received"] = len(received)
