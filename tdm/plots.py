@@ -53,6 +53,27 @@ def _colour(index: int):
     return matplotlib.colormaps[ID_COLORMAP](index % 20)
 
 
+def recording_title(recording: Path) -> str:
+    """The recording's name for titles: ``"<scenario> (seed N)"`` from its manifest or scenario.yaml.
+
+    Never the directory's name, which differs between identical runs (``raysim run`` evaluates in a
+    staging directory ``.NAME.partial-PID``); ``"recording"`` when neither file names the scenario.
+    """
+    from tdm.io import read_scenario
+
+    recording = Path(recording)
+    for read in (lambda: json.loads((recording / "manifest.json").read_text(encoding="utf-8")),
+                 lambda: read_scenario(recording)):
+        try:
+            meta = read()
+        except (OSError, ValueError, RecordingError):
+            continue
+        if isinstance(meta, dict) and meta.get("scenario", meta.get("name")):
+            name = meta.get("scenario", meta.get("name"))
+            return f"{name} (seed {meta['seed']})" if meta.get("seed") is not None else str(name)
+    return "recording"
+
+
 def plot_tracks(recording: Path, out_png: Path | None = None) -> Path:
     """Targets' tracks coloured by target id over the truth tracks and the own ship's path.
 
@@ -103,7 +124,8 @@ def plot_tracks(recording: Path, out_png: Path | None = None) -> Path:
     ax.set_ylabel("north [m]")
     ax.grid(True, lw=0.4, alpha=0.5)
     ax.legend(loc="best", fontsize=8)
-    ax.set_title(f"{recording.name}: detected targets over truth (ENU about the own ship's start)", fontsize=9)
+    ax.set_title(f"{recording_title(recording)}: detected targets over truth (ENU about the own ship's start)",
+                 fontsize=9)
     return _save(fig, out_png if out_png is not None else recording / "tdm" / "tracks.png")
 
 
@@ -162,7 +184,7 @@ def plot_errors(recording: Path, metrics_or_series: dict | None = None, out_png:
     ax_err.grid(True, lw=0.4, alpha=0.5)
     if pid.size:
         ax_err.legend(loc="upper right", fontsize=6, ncol=2)
-    ax_err.set_title(f"{recording.name}: matched position error per truth object", fontsize=9)
+    ax_err.set_title(f"{recording_title(recording)}: matched position error per truth object", fontsize=9)
 
     ax_set.plot(t_s, np.asarray(series["ospa_m"], dtype=float), "-", color="tab:blue", lw=1.2, label="OSPA")
     ax_set.plot(t_s, np.asarray(series["gospa_m"], dtype=float), "-", color="tab:red", lw=1.2, label="GOSPA")
