@@ -26,7 +26,8 @@ def render_detect_evaluate(scenario: Scenario, out_dir: Path, progress: bool | N
     out_dir : Path
         Recording directory.
     progress : bool, optional
-        Progress bars (render and TDM); default: when stderr is a terminal.
+        Progress of every stage, the TDM's ``tdm run`` and ``tdm evaluate`` too (:mod:`raysim.progress`):
+        default bars when stderr is a terminal, lines otherwise; ``False`` nothing.
     formats : tuple of str
         Extra point-cloud files (:func:`raysim.render.render`).
     tdm_workers : int
@@ -38,6 +39,7 @@ def render_detect_evaluate(scenario: Scenario, out_dir: Path, progress: bool | N
     metrics : dict
         ``tdm/metrics.json``'s content.
     """
+    from raysim.progress import bars, stage
     from tdm.cli import evaluate_command, run_command
     from tdm.errors import RecordingError
 
@@ -45,8 +47,11 @@ def render_detect_evaluate(scenario: Scenario, out_dir: Path, progress: bool | N
 
     def detect_and_evaluate(staged: Path) -> dict[str, int]:
         try:
-            result = run_command(staged, workers=tdm_workers, progress=progress)
-            metrics.update(evaluate_command(staged))
+            with stage("tdm run", progress, "detect and track targets", bar=True) as step:
+                result = run_command(staged, workers=tdm_workers, progress=bars(progress))
+                step.done = f"{result.n_targets} targets over {result.n_epochs} epochs"
+            with stage("tdm evaluate", progress, "metrics against truth, plots") as step:
+                metrics.update(evaluate_command(staged))
         except RecordingError as exc:  # the recording was just written: this is a bug, not bad input
             raise RuntimeError(f"tdm failed on the fresh recording: {exc}") from exc
         counts = {"tdm/detected_targets.jsonl": result.n_target_lines, "tdm/targets": result.n_targets}
