@@ -3,16 +3,19 @@
 One picture per second of scenario (every ``rotation_hz``-th sweep, named after it), 800 x 800
 pixels for +-100 m around the sensor (the HDL-32E's range), sensor frame with x (forward) up:
 points coloured by intensity (dark blue 0 to yellow 255), each object's truth box (length x beam at
-its truth pose at the sweep's first point, in the own ship's level frame) outlined in red.
+its truth pose at the sweep's first point, in the own ship's level frame) outlined in red. The
+picture says what it shows: the sweep's time (UTC and t) top left, a 20 m scale bar bottom left, a
+key (the intensity colour ramp, the truth box) bottom right.
 """
 
 from __future__ import annotations
 
+import datetime as dt
 import math
 from pathlib import Path
 
 import numpy as np
-from PIL import Image, ImageDraw
+from PIL import Image, ImageDraw, ImageFont
 
 from raysim.recording.jsonl import truth_epochs
 from raysim.recording.staging import atomic_path
@@ -21,12 +24,44 @@ __all__ = ["write_bev"]
 
 SIZE_PX = 800
 HALF_RANGE_M = 100.0
+SCALE_BAR_M = 20.0
+BOX_COLOUR = (255, 40, 40)
+TEXT = (210, 210, 210)
+KEY_FILL = (24, 24, 24)  # not black: a point under the key still shows as drawn
+FONT_PX = 13  # Pillow's bundled font (the same glyphs everywhere: the pictures stay byte-identical)
 
 
 def _colour(intensity: np.ndarray) -> np.ndarray:
     """(N, 3) uint8: dark blue (0) through green to yellow (255)."""
     v = np.clip(intensity.astype(np.float32) / 255.0, 0.0, 1.0) ** 0.5
     return np.stack([255 * v, 80 + 175 * v, 200 * (1 - v) + 30], axis=1).astype(np.uint8)
+
+
+def _annotate(draw: ImageDraw.ImageDraw, time_s: float, start_time: dt.datetime) -> None:
+    """Time (top left), a :data:`SCALE_BAR_M` scale bar (bottom left), the key (bottom right)."""
+    font = ImageFont.load_default(size=FONT_PX)
+    utc = start_time.astimezone(dt.timezone.utc) + dt.timedelta(seconds=time_s)
+    stamp = utc.strftime("%Y-%m-%d %H:%M:%S.") + f"{utc.microsecond // 100_000} UTC"
+    draw.text((6, 6), f"{stamp}, t = {time_s:.1f} s (sweep start)", fill=TEXT, font=font)
+    draw.text((6, 22), f"LiDAR from above, +-{HALF_RANGE_M:g} m, forward up", fill=TEXT, font=font)
+    scale = SIZE_PX / (2 * HALF_RANGE_M)
+    x0, y0 = 12, SIZE_PX - 14
+    x1 = x0 + SCALE_BAR_M * scale
+    draw.line([(x0, y0), (x1, y0)], fill=TEXT, width=3)
+    draw.line([(x0, y0 - 5), (x0, y0 + 3)], fill=TEXT, width=1)
+    draw.line([(x1, y0 - 5), (x1, y0 + 3)], fill=TEXT, width=1)
+    draw.text((x0, y0 - 20), f"{SCALE_BAR_M:g} m", fill=TEXT, font=font)
+    # key: the intensity ramp and the truth box
+    left, top, ramp_px = SIZE_PX - 196, SIZE_PX - 66, 128
+    draw.rectangle([left - 6, top - 6, SIZE_PX - 6, SIZE_PX - 6], fill=KEY_FILL, outline=(90, 90, 90))
+    ramp = _colour(np.arange(256)[np.linspace(0, 255, ramp_px).round().astype(int)])
+    for k, colour in enumerate(ramp):
+        draw.line([(left + k, top), (left + k, top + 9)], fill=tuple(int(c) for c in colour))
+    draw.text((left + ramp_px + 6, top - 2), "intensity", fill=TEXT, font=font)
+    draw.text((left, top + 11), "0", fill=TEXT, font=font)
+    draw.text((left + ramp_px - draw.textlength("255", font=font), top + 11), "255", fill=TEXT, font=font)
+    draw.rectangle([left, top + 33, left + 18, top + 43], outline=BOX_COLOUR)
+    draw.text((left + 26, top + 30), "truth box (length x beam)", fill=TEXT, font=font)
 
 
 def write_bev(recording: Path, scenario) -> int:
@@ -76,8 +111,8 @@ def write_bev(recording: Path, scenario) -> int:
                     sx = (wx - ox) * c + (wy - oy) * s
                     sy = -(wx - ox) * s + (wy - oy) * c
                     corners.append((SIZE_PX / 2 - sy * scale, SIZE_PX / 2 - sx * scale))
-                draw.polygon(corners, outline=(255, 40, 40))
-        draw.text((6, 6), f"t = {starts[path]:.1f} s, +-{HALF_RANGE_M:g} m, forward up", fill=(200, 200, 200))
+                draw.polygon(corners, outline=BOX_COLOUR)
+        _annotate(draw, starts[path], scenario.start_time)
         with atomic_path(folder / f"{path.stem}.png") as tmp:
             picture.save(tmp, format="PNG")
     return len(chosen)

@@ -2,16 +2,20 @@
 
 North-up: each spoke is drawn at its true bearing (the own ship's heading at that spoke plus
 the antenna azimuth), the own ship at the centre, range rings at quarters of the range scale,
-a heading line, video levels 0..15 as phosphor green on black.
+a heading line, video levels 0..15 as phosphor green on black. The corners outside the
+display say what a navigator reads off the set: heading, time of the revolution, range scale
+and ring spacing, receiver settings (gain, sea and rain control).
 """
 
 from __future__ import annotations
 
+import datetime as dt
+from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
-from PIL import Image, ImageDraw
+from PIL import Image, ImageDraw, ImageFont
 
 from raysim.recording.staging import atomic_path
 
@@ -21,6 +25,81 @@ SIZE_PX = 800
 #: phosphor green: video level 0..15 -> RGB
 PALETTE = np.array([[40 * v, 40 + 215 * v, 20 + 60 * v] for v in np.arange(16) / 15.0]).astype(np.uint8)
 BEARING_BINS = 7200  # 0.05 deg: finer than the finest spoke spacing drawn (8192 spokes: 0.044 deg ~ one bin)
+METRES_PER_NM = 1852.0
+FONT_PX = 13  # Pillow's bundled font (the same glyphs everywhere: the pictures stay byte-identical)
+TEXT = (170, 215, 170)
+LINE_PX = 16
+
+
+@dataclass(frozen=True)
+class PpiLabels:
+    """What the corners of a PPI say beside the picture's own arrays (heading, time, range).
+
+    Attributes
+    ----------
+    start_time : datetime.datetime or None
+        UTC of the scenario's t = 0 (the sweep's times count from it).
+    gain_db : float or None
+        Receiver gain re. the default setting, dB.
+    sea_clutter_control_db : float or None
+        Sea control (STC) at 100 m, dB; 0 = off.
+    rain_clutter_control_m : float or None
+        Rain control (FTC) time constant, m; 0 = off.
+    """
+
+    start_time: dt.datetime | None = None
+    gain_db: float | None = None
+    sea_clutter_control_db: float | None = None
+    rain_clutter_control_m: float | None = None
+
+    @classmethod
+    def from_scenario(cls, scenario) -> "PpiLabels":
+        """The labels of a scenario's ``start_time`` and ``sensors.radar`` receiver settings."""
+        cfg = scenario.sensors.radar
+        return cls(scenario.start_time, cfg.gain_db, cfg.sea_clutter_control_db, cfg.rain_clutter_control_m)
+
+    def receiver_lines(self) -> list[str]:
+        """``gain +0 dB``, ``sea (STC) 20 dB``, ``rain (FTC) off``: the settings that are known."""
+        lines = []
+        if self.gain_db is not None:
+            lines.append(f"gain {self.gain_db:+g} dB")
+        sea, rain = self.sea_clutter_control_db, self.rain_clutter_control_m
+        if sea is not None:
+            lines.append(f"sea (STC) {sea:g} dB" if sea else "sea (STC) off")
+        if rain is not None:
+            lines.append(f"rain (FTC) {rain:g} m" if rain else "rain (FTC) off")
+        return lines
+
+
+def _nm(metres: float) -> str:
+    """Nautical miles, as few digits as exact to 1/1000 NM: ``1.5``, ``0.375``, ``0.25``."""
+    return f"{round(metres / METRES_PER_NM, 3):g}"
+
+
+def _corner_text(draw: ImageDraw.ImageDraw, size_px: int, corner: str, lines: list[str]) -> None:
+    """Write ``lines`` into ``corner`` (``"tl"``, ``"tr"``, ``"bl"``, ``"br"``), outside the display circle."""
+    font = ImageFont.load_default(size=FONT_PX)
+    top = corner[0] == "t"
+    for k, line in enumerate(lines):
+        y = 6 + k * LINE_PX if top else size_px - 6 - (len(lines) - k) * LINE_PX
+        x = 6 if corner[1] == "l" else size_px - 6 - draw.textlength(line, font=font)
+        draw.text((x, y), line, fill=TEXT, font=font)
+
+
+def _annotate(draw: ImageDraw.ImageDraw, size_px: int, range_m: np.ndarray, heading_deg: float,
+              time_s: float | None, labels: PpiLabels | None) -> None:
+    """Corner texts: heading (top left), time (top right), range (bottom left), receiver (bottom right)."""
+    labels = labels or PpiLabels()
+    _corner_text(draw, size_px, "tl", ["N up", f"HDG {heading_deg % 360.0:05.1f}\N{DEGREE SIGN}"])
+    if time_s is not None:
+        when = [f"t = {time_s:.1f} s (first spoke)"]
+        if labels.start_time is not None:
+            utc = labels.start_time.astimezone(dt.timezone.utc) + dt.timedelta(seconds=time_s)
+            when.insert(0, utc.strftime("%Y-%m-%d %H:%M:%S.") + f"{utc.microsecond // 100_000} UTC")
+        _corner_text(draw, size_px, "tr", when)
+    scale_m = float(range_m[-1])
+    _corner_text(draw, size_px, "bl", [f"range {_nm(scale_m)} NM ({scale_m:g} m)", f"rings {_nm(scale_m / 4)} NM"])
+    _corner_text(draw, size_px, "br", labels.receiver_lines())
 
 
 @lru_cache(maxsize=4)
@@ -39,8 +118,8 @@ def _pixel_geometry(size_px: int, samples: int, range_scale_m: float):
 
 
 def ppi_image(echo: np.ndarray, azimuth_deg: np.ndarray, heading_deg: np.ndarray, range_m: np.ndarray,
-              size_px: int = SIZE_PX) -> Image.Image:
-    """North-up PPI of one sweep.
+              size_px: int = SIZE_PX, time_s: np.ndarray | None = None, labels: PpiLabels | None = None) -> Image.Image:
+    """North-up PPI of one sweep, ``size_px`` x ``size_px`` pixels, with its corner texts.
 
     Parameters
     ----------
@@ -50,6 +129,12 @@ def ppi_image(echo: np.ndarray, azimuth_deg: np.ndarray, heading_deg: np.ndarray
         Antenna azimuth from the bow and own-ship heading of each spoke, degrees.
     range_m : (N,) float
         Range of each sample (first at the antenna, last at the range scale, evenly spaced).
+    size_px : int
+        Width and height of the picture, pixels.
+    time_s : (S,) float, optional
+        Time of each spoke, s since the scenario start (the first is written in a corner).
+    labels : PpiLabels, optional
+        UTC start and receiver settings for the corners (left out when not given).
     """
     spokes, samples = echo.shape
     half = size_px / 2.0
@@ -67,15 +152,19 @@ def ppi_image(echo: np.ndarray, azimuth_deg: np.ndarray, heading_deg: np.ndarray
     for quarter in (1, 2, 3, 4):
         r = half * quarter / 4
         draw.ellipse([half - r, half - r, half + r, half + r], outline=(70, 110, 70))
-        draw.text((half + 4, half - r + 2), f"{range_m[-1] * quarter / 4 / 1852:.2f} NM", fill=(120, 170, 120))
+        draw.text((half + 4, half - r + 2), f"{_nm(range_m[-1] * quarter / 4)} NM", fill=(120, 170, 120))
     h = np.radians(heading_deg[0])
     draw.line([half, half, half + half * np.sin(h), half - half * np.cos(h)], fill=(200, 200, 200))
-    draw.text((6, 6), "N up", fill=(160, 200, 160))
+    _annotate(draw, size_px, range_m, float(heading_deg[0]), None if time_s is None else float(time_s[0]), labels)
     return image
 
 
-def write_ppi(path: Path, sweep: dict[str, np.ndarray]) -> None:
-    """Write the PPI picture of a sweep (the NPZ arrays) as PNG, atomically."""
-    image = ppi_image(sweep["echo"], sweep["azimuth_deg"], sweep["heading_deg"], sweep["range_m"])
+def write_ppi(path: Path, sweep: dict[str, np.ndarray], labels: PpiLabels | None = None) -> None:
+    """Write the PPI picture of a sweep (the NPZ arrays, ``time`` optional) as PNG, atomically.
+
+    ``labels`` (:meth:`PpiLabels.from_scenario`) adds the UTC time and the receiver settings.
+    """
+    image = ppi_image(sweep["echo"], sweep["azimuth_deg"], sweep["heading_deg"], sweep["range_m"],
+                      time_s=sweep.get("time"), labels=labels)
     with atomic_path(Path(path)) as tmp:
         image.save(tmp, format="PNG", optimize=False, compress_level=3)
