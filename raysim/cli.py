@@ -1,4 +1,4 @@
-"""The ``raysim`` command: it only wires (DESIGN.md "Command-line contract").
+"""The ``raysim`` command: it only wires (docs/contracts.md "Command line").
 
 Bad input of any kind prints one line ``error: <file>: <place>: <what>`` on
 stderr and exits with code 2, leaving nothing behind.
@@ -193,13 +193,71 @@ def cmd_batch(args) -> int:
     return 1 if failed else 0
 
 
-def _summary(result) -> None:
-    m = result.manifest
-    counts = ", ".join(f"{k}: {v}" for k, v in m["counts"].items())
-    print(f"rendered {m['scenario']} ({m['duration_s']:g} s, seed {m['seed']}) into {result.out_dir} in {m['wall_time_s']['total']:.1f} s")
-    print(f"  {counts}")
+#: manifest ``wall_time_s`` key -> the summary's name for that part of the run (the rest is "render")
+WALL_PARTS = {"tdm": "tdm", "rosbag": "bag", "pictures": "pictures", "pointclouds": "point clouds"}
+
+
+def _bytes_text(n_bytes: int) -> str:
+    """``4.4 GB``, ``89 MB``, ``512 B``: decimal units, two or three significant digits."""
+    for unit, size in (("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
+        if n_bytes >= size:
+            value = n_bytes / size
+            return f"{value:.1f} {unit}" if value < 10 else f"{value:.0f} {unit}"
+    return f"{n_bytes} B"
+
+
+def _doc(name: str) -> str:
+    """Path of the source tree's ``docs/<name>``: relative when under the working directory, else absolute."""
+    path = Path(__file__).resolve().parents[1] / "docs" / name
+    if not path.parent.is_dir():  # installed without the source tree
+        return f"docs/{name}"
+    try:
+        return str(path.relative_to(Path.cwd().resolve()))
+    except ValueError:
+        return str(path)
+
+
+def summary_lines(out_dir: Path, manifest: dict) -> list[str]:
+    """What ``raysim render`` / ``raysim run`` print at the end.
+
+    Parameters
+    ----------
+    out_dir : Path
+        The recording directory written.
+    manifest : dict
+        Its manifest.json (``wall_time_s`` holds the parts of the time: :data:`WALL_PARTS`).
+
+    Returns
+    -------
+    list of str
+        What was done, in how long (total and per part) and how many bytes were written; the
+        counts; sensors not rendered; where to look next (the bag in Foxglove, the pictures, the docs).
+    """
+    m, out = manifest, Path(out_dir)
+    wall = m["wall_time_s"]
+    parts = {label: wall[key] for key, label in WALL_PARTS.items() if key in wall}
+    parts = {"render": wall["total"] - sum(parts.values()), **parts}
+    times = ", ".join(f"{label} {s:.1f} s" for label, s in parts.items())
+    written = sum(p.stat().st_size for p in out.rglob("*") if p.is_file())
+    verb = "rendered, detected and evaluated" if "tdm" in wall else "rendered"
+    lines = [f"{verb} {m['scenario']} ({m['duration_s']:g} s, seed {m['seed']}) into {out} in {wall['total']:.1f} s "
+             f"({times}); {_bytes_text(written)} written",
+             "  " + ", ".join(f"{k}: {v}" for k, v in m["counts"].items())]
     if m["sensors_not_available"]:
-        print(f"  not rendered (not implemented in this version): {', '.join(m['sensors_not_available'])}")
+        lines.append(f"  not rendered (not implemented in this version): {', '.join(m['sensors_not_available'])}")
+    bags = sorted((out / "rosbag").glob("*.mcap"))
+    if bags:
+        lines.append(f"  next: open {bags[0]} in Foxglove with the layout {_doc('foxglove_layout.json')}")
+    folders = [f"{out / d}/" for d in ("radar/ppi", "lidar/bev") if any((out / d).glob("*.png"))]
+    pictures = [str(out / "map.png"), *folders]
+    pictures += [str(p) for p in sorted((out / "tdm").glob("*.png"))]
+    lines.append(f"  pictures: {', '.join(pictures)}")
+    lines.append(f"  every file and how to open it: {_doc('formats.md')}")
+    return lines
+
+
+def _summary(result) -> None:
+    print("\n".join(summary_lines(result.out_dir, result.manifest)))
 
 
 def cmd_import_hilsim(args) -> int:

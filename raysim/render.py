@@ -1,4 +1,4 @@
-"""Render a scenario into a recording directory (DESIGN.md "Recording directory contract").
+"""Render a scenario into a recording directory (docs/contracts.md "Recording directory").
 
 The pipeline: build the world (meshes, motions), then stream each product chunk
 by chunk into a staged directory that is moved into place only when everything
@@ -10,7 +10,6 @@ from __future__ import annotations
 import datetime as dt
 import json
 import platform
-import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -21,12 +20,14 @@ from tqdm import tqdm
 
 from raysim import __version__, schema
 from raysim.pose import heading_deg_from_yaw
+from raysim.progress import bars as progress_bars
+from raysim.progress import stage
 from raysim.recording.jsonl import course_and_speed, write_ownship_chunk, write_truth_chunk
 from raysim.recording.staging import MANIFEST, StagedDirectory, atomic_path
 from raysim.scenario import Scenario, scenario_to_yaml
 from raysim.world import World
 
-TRUTH_RATE_HZ = 10.0  # DESIGN.md: one truth line per object per 0.1 s
+TRUTH_RATE_HZ = 10.0  # docs/contracts.md: one truth line per object per 0.1 s
 CHUNK_S = 30.0  # seconds of truth / navigation formatted at a time (memory stays flat)
 
 
@@ -72,8 +73,9 @@ def _render_ais(ctx: "RenderContext") -> None:
 
 
 def _render_nav(ctx: "RenderContext") -> None:
-    """nav/nav.nmea (:func:`write_nav_nmea`); ownship.jsonl is written whether or not nav is enabled."""
-    ctx.counts["nav/nav.nmea"] = write_nav_nmea(ctx.world, ctx.out_dir / "nav" / "nav.nmea", ctx.progress)
+    """nav/nav.nmea and nav/nav_plain.nmea (:func:`write_nav_nmea`); ownship.jsonl is written either way."""
+    lines = write_nav_nmea(ctx.world, ctx.out_dir / "nav" / "nav.nmea", ctx.progress)
+    ctx.counts["nav/nav.nmea"] = ctx.counts["nav/nav_plain.nmea"] = lines
 
 
 SENSOR_RENDERERS: dict[str, Callable[[RenderContext], None]] = {"lidar": _render_lidar, "radar": _render_radar,
@@ -138,10 +140,14 @@ def write_ownship(world: World, path: Path, progress: bool) -> int:
     return lines
 
 
-def write_nav_nmea(world: World, path: Path, progress: bool) -> int:
-    """Write nav/nav.nmea: TAG block + $GPRMC, $GPGGA, $HEHDT per NMEA epoch. Returns the number of lines.
+def write_nav_nmea(world: World, path: Path, progress: bool, plain_path: Path | None = None) -> int:
+    r"""Write nav/nav.nmea and nav/nav_plain.nmea in one pass. Returns the number of lines of each.
 
-    The values are the navigation solution of ownship.jsonl at the grid samples of
+    Per NMEA epoch the sentences of :func:`raysim.recording.nmea.nav_epoch` ($GPRMC, $GPGGA, $GPVTG,
+    $GPZDA, $HEHDT). ``path`` gets each line prefixed by an NMEA 4.10 TAG block (``\n`` line ends,
+    for loggers and the TDM); ``plain_path`` (default ``nav_plain.nmea`` beside ``path``) the same
+    sentences without TAG blocks and with CR LF line ends, as on an NMEA 0183 wire (chart plotters,
+    pynmea2, gpsd). The values are the navigation solution of ownship.jsonl at the grid samples of
     :func:`raysim.sensors.nav.nmea_indices` (every 50th sample with the default 50 Hz / 1 Hz).
     """
     from raysim.recording import nmea
@@ -149,23 +155,27 @@ def write_nav_nmea(world: World, path: Path, progress: bool) -> int:
 
     s = world.scenario
     cfg = s.sensors.nav
+    plain_path = Path(path).with_name(Path(path).stem + "_plain.nmea") if plain_path is None else plain_path
     indices = nmea_indices(s.duration_s, cfg.rate_hz, cfg.nmea_rate_hz)
     step = max(1, int(CHUNK_S * cfg.rate_hz))
     chunks = -(-grid_size(s.duration_s, cfg.rate_hz) // step)
     lines = 0
-    with atomic_path(path) as tmp, open(tmp, "w", encoding="ascii", newline="\n") as handle:
+    with atomic_path(path) as tmp, open(tmp, "w", encoding="ascii", newline="\n") as tagged, \
+            atomic_path(plain_path) as plain_tmp, open(plain_tmp, "w", encoding="ascii", newline="\n") as plain:
         for t, c in tqdm(navigation_chunks(world, step, indices), total=chunks, desc="nav", unit="chunk",
                          disable=not progress, leave=False):
-            out = []
+            tagged_out, plain_out = [], []
             for k, t_s in enumerate(t.tolist()):
                 utc = s.start_time + dt.timedelta(seconds=t_s)
                 tag = nmea.tag_block(utc.timestamp())
-                lat, lon = float(c["lat"][k]), float(c["lon"][k])
-                out += [tag + nmea.gprmc(utc, lat, lon, float(c["sog_mps"][k]), float(c["cog_deg"][k])),
-                        tag + nmea.gpgga(utc, lat, lon, float(c["z"][k])),
-                        tag + nmea.hehdt(float(c["heading_deg"][k]))]
-            handle.write("".join(line + "\n" for line in out))
-            lines += len(out)
+                epoch = nmea.nav_epoch(utc, float(c["lat"][k]), float(c["lon"][k]), float(c["z"][k]),
+                                       float(c["sog_mps"][k]), float(c["cog_deg"][k]), float(c["heading_deg"][k]),
+                                       cfg.geoid_separation_m)
+                tagged_out += [tag + sentence + "\n" for sentence in epoch]
+                plain_out += [sentence + "\r\n" for sentence in epoch]
+            tagged.write("".join(tagged_out))
+            plain.write("".join(plain_out))
+            lines += len(plain_out)
     return lines
 
 
@@ -185,6 +195,51 @@ def _versions() -> dict:
     return versions
 
 
+def _sensor_plan(scenario: Scenario, name: str) -> str:
+    """What sensor ``name`` is about to render, for the progress lines (e.g. ``"60 revolutions"``)."""
+    cfg, duration_s = getattr(scenario.sensors, name), scenario.duration_s
+    if name == "lidar":
+        return f"{duration_s * cfg.rotation_hz:.0f} revolutions of the HDL-32E"
+    if name == "radar":
+        return f"{int(duration_s * cfg.rpm / 60.0 + 1e-9)} revolutions of {cfg.spokes} spokes"
+    return f"{duration_s:g} s of {'AIS traffic' if name == 'ais' else 'navigation NMEA'}"
+
+
+def _write_derived(ctx: RenderContext, scenario: Scenario, formats: tuple[str, ...], progress: bool | None) -> None:
+    """The files made from the staged recording's own: the bag, the pictures, the point-cloud files.
+
+    Each is a progress stage (:func:`raysim.progress.stage`) timed in ``ctx.wall_time_s``
+    (``rosbag``, ``pictures``, ``pointclouds``); their counts go to ``ctx.counts``.
+    """
+    from raysim.recording.map_picture import write_map
+    from raysim.recording.rosbag import write_rosbag
+
+    staged, wall = ctx.out_dir, ctx.wall_time_s
+    with stage("rosbag", progress, "ROS 2 bag (MCAP)") as step:
+        for topic, n in write_rosbag(staged, scenario).items():
+            ctx.counts[f"rosbag{topic}"] = n
+        step.done = f"{sum(v for k, v in ctx.counts.items() if k.startswith('rosbag/'))} messages"
+    wall["rosbag"] = step.elapsed_s
+    lidar = (staged / "lidar" / "sweeps").is_dir()
+    with stage("pictures", progress, "map.png" + (", LiDAR bird's-eye views" if lidar else "")) as step:
+        write_map(staged, scenario.start_time)
+        ctx.counts["map.png"] = 1
+        if lidar:
+            from raysim.recording.bev import write_bev
+
+            ctx.counts["lidar/bev"] = write_bev(staged, scenario)
+        step.done = f"{1 + ctx.counts.get('lidar/bev', 0)} pictures"
+    wall["pictures"] = step.elapsed_s
+    if formats:
+        from raysim.recording.pointclouds import write_point_cloud_files
+
+        with stage("pointclouds", progress, ", ".join(formats) + " files") as step:
+            made = write_point_cloud_files(staged, tuple(formats))
+            ctx.counts.update(made)
+            step.done = ", ".join(f"{n} {k}" for k, n in made.items())
+        wall["pointclouds"] = step.elapsed_s
+
+
 def render(scenario: Scenario, out_dir: Path, progress: bool | None = None, formats: tuple[str, ...] = (),
            after_sensors: Callable[[Path], dict[str, int]] | None = None) -> RenderResult:
     """Render ``scenario`` into ``out_dir``; all or nothing.
@@ -196,7 +251,8 @@ def render(scenario: Scenario, out_dir: Path, progress: bool | None = None, form
     out_dir : Path
         Recording directory; replaced if it holds an older recording.
     progress : bool, optional
-        Show progress bars; default: when stderr is a terminal.
+        Progress on stderr (:mod:`raysim.progress`): default bars when stderr is a terminal, a line
+        per stage start and end otherwise; ``True`` bars, ``False`` nothing.
     formats : tuple of str
         Extra point-cloud files from the LiDAR sweeps (:data:`raysim.recording.pointclouds.FORMATS`).
     after_sensors : callable, optional
@@ -204,33 +260,35 @@ def render(scenario: Scenario, out_dir: Path, progress: bool | None = None, form
         manifest are written (``raysim run`` runs the TDM here, so its targets join the bag);
         returns counts to add to the manifest. An error in it leaves nothing on disk.
     """
-    if progress is None:
-        progress = sys.stderr.isatty()
+    bars = progress_bars(progress)  # the stages' own tqdm bars
     started = time.perf_counter()
     wall: dict[str, float] = {}
-    t0 = time.perf_counter()
-    world = World(scenario)
-    wall["world"] = time.perf_counter() - t0
+    with stage("world", progress, f"meshes and motions of {scenario.name}") as step:
+        world = World(scenario)
+        step.done = f"{len(world.objects)} objects"
+    wall["world"] = step.elapsed_s
     enabled = scenario.sensors.enabled_names()
     with StagedDirectory(Path(out_dir)) as staged:
-        ctx = RenderContext(world, staged.path, progress, wall_time_s=wall)
+        ctx = RenderContext(world, staged.path, bars, wall_time_s=wall)
         with atomic_path(staged.path / "scenario.yaml") as tmp:
             tmp.write_text(scenario_to_yaml(scenario), encoding="utf-8")
-        t0 = time.perf_counter()
-        ctx.counts["truth.jsonl"] = write_truth(world, staged.path / "truth.jsonl", progress)
-        wall["truth"] = time.perf_counter() - t0
-        t0 = time.perf_counter()
-        ctx.counts["ownship.jsonl"] = write_ownship(world, staged.path / "ownship.jsonl", progress)
-        wall["ownship"] = time.perf_counter() - t0
+        for name, write in (("truth", write_truth), ("ownship", write_ownship)):
+            with stage(name, progress, f"{scenario.duration_s:g} s", bar=True) as step:
+                ctx.counts[f"{name}.jsonl"] = write(world, staged.path / f"{name}.jsonl", bars)
+                step.done = f"{ctx.counts[f'{name}.jsonl']} lines"
+            wall[name] = step.elapsed_s
         rendered, not_available = [], []
         for name in enabled:
             renderer = SENSOR_RENDERERS.get(name)
             if renderer is None:
                 not_available.append(name)
                 continue
-            t0 = time.perf_counter()
-            renderer(ctx)
-            wall[name] = time.perf_counter() - t0
+            before = set(ctx.counts)
+            with stage(name, progress, _sensor_plan(scenario, name), bar=name != "ais") as step:  # AIS: no bar
+                renderer(ctx)
+                made = sorted(set(ctx.counts) - before)
+                step.done = ", ".join(f"{ctx.counts[k]} {k.split('/', 1)[-1]}" for k in made)
+            wall[name] = step.elapsed_s
             rendered.append(name)
         def manifest_now() -> dict:
             return {
@@ -255,24 +313,7 @@ def render(scenario: Scenario, out_dir: Path, progress: bool | None = None, form
             t0 = time.perf_counter()
             ctx.counts.update(after_sensors(staged.path))
             wall["tdm"] = time.perf_counter() - t0
-        t0 = time.perf_counter()
-        from raysim.recording.rosbag import write_rosbag
-
-        for topic, n in write_rosbag(staged.path, scenario).items():
-            ctx.counts[f"rosbag{topic}"] = n
-        wall["rosbag"] = time.perf_counter() - t0
-        from raysim.recording.map_picture import write_map
-
-        write_map(staged.path)
-        ctx.counts["map.png"] = 1
-        if (staged.path / "lidar" / "sweeps").is_dir():
-            from raysim.recording.bev import write_bev
-
-            ctx.counts["lidar/bev"] = write_bev(staged.path, scenario)
-        if formats:
-            from raysim.recording.pointclouds import write_point_cloud_files
-
-            ctx.counts.update(write_point_cloud_files(staged.path, tuple(formats)))
+        _write_derived(ctx, scenario, formats, progress)
         wall["total"] = time.perf_counter() - started
         manifest = manifest_now()
         with atomic_path(staged.path / MANIFEST) as tmp:

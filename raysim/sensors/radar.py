@@ -22,7 +22,7 @@ Per revolution (all spokes at once, numpy-vectorised):
 6. Receiver: thermal noise (exponential power, mean 1 = the noise level), STC, log video,
    4-bit quantisation on fixed levels re. noise.
 
-Outputs (DESIGN.md recording contract): ``radar/sweeps/NNNNNN.npz`` and ``radar/ppi/NNNNNN.png``.
+Outputs (docs/contracts.md, recording directory): ``radar/sweeps/NNNNNN.npz`` and ``radar/ppi/NNNNNN.png``.
 """
 
 from __future__ import annotations
@@ -40,7 +40,7 @@ from raysim.materials import material_table
 from raysim.pose import heading_deg_from_yaw
 from raysim.random_streams import stream
 from raysim.recording.npz import write_npz
-from raysim.recording.ppi import write_ppi
+from raysim.recording.ppi import PpiLabels, write_ppi
 from raysim.scene import NO_HIT, SEA_ID
 from raysim.sensors import radar_physics as phys
 from raysim.sensors.carrier import CarrierScene
@@ -437,7 +437,7 @@ class RadarRenderer:
             started = time.perf_counter()
             out = self.revolution(rev)
             write_npz(sweeps_dir / f"{rev:06d}.npz", out.arrays())
-            write_ppi(ppi_dir / f"{rev:06d}.png", out.arrays())
+            write_ppi(ppi_dir / f"{rev:06d}.png", out.arrays(), PpiLabels.from_scenario(self.world.scenario))
             counts["sweeps"] += 1
             counts["spokes"] += self.spokes
             self.rev_wall_s.append(time.perf_counter() - started)
