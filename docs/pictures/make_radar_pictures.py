@@ -15,7 +15,7 @@ import dataclasses
 from pathlib import Path
 
 from raysim.materials import material_index
-from raysim.recording.ppi import ppi_image
+from raysim.recording.ppi import PpiLabels, ppi_image
 from raysim.scenario import load_scenario
 from raysim.sensors.carrier import CarrierScene
 from raysim.sensors.radar import RadarRenderer
@@ -44,7 +44,8 @@ def main(argv=None) -> int:
         renderer = RadarRenderer(world, scene)
         sweep = renderer.render_revolution(int(args.time / renderer.rev_s))
         out = HERE / f"{base.name}_ppi_{case}.png"
-        ppi_image(sweep["echo"], sweep["azimuth_deg"], sweep["heading_deg"], sweep["range_m"]).save(out)
+        ppi_image(sweep["echo"], sweep["azimuth_deg"], sweep["heading_deg"], sweep["range_m"], time_s=sweep["time"],
+                  labels=PpiLabels.from_scenario(scenario)).save(out)
         print(out)
     return 0
 
