@@ -317,6 +317,10 @@ class AisTrackerConfig:
 
 
 KNOT_MPS = 1852.0 / 3600.0
+#: Prior variances of an AIS track's states that its first report does not measure: position
+#: (always measured), course pi^2 (unknown), speed (5 m/s)^2, turn rate (3 deg/s)^2, cross-section
+#: (1000 m^2)^2.
+AIS_PRIOR_VAR = (1e6, 1e6, np.pi**2, 25.0, np.radians(3.0) ** 2, 1e6)
 
 
 class AisTracker:
@@ -353,19 +357,30 @@ class AisTracker:
         t = float(report.time_s)
         track = self.tracks.get(report.mmsi)
         if track is None or t - track.updated_s > cfg.coast_s:
-            x = np.zeros(ekf.N_STATES)
-            p = np.diag([100.0, 100.0, np.pi**2, 25.0, np.radians(3.0) ** 2, 1e6])
-            track = Track(next(self._ids), "ais", x, p, t, t, t, confirmed=True, n_updates=0,
-                          mmsi=report.mmsi, process=cfg.process)
-            static = self.static.get(report.mmsi)
-            if static is not None and np.isfinite(static.length_m * static.beam_m):
-                track.x[ekf.ALPHA] = static.length_m * static.beam_m
-            self.tracks[report.mmsi] = track
+            self.tracks[report.mmsi] = self._start(report, rows, z, var)
+            return
         x, p = track.predicted(t)
         h = ekf.h_rows(*rows)
         track.x, track.p, _ = ekf.update(x, p, np.array(z, dtype=float), h, np.diag(var), angle_rows)
         track.t_s = track.updated_s = t
         track.n_updates += 1
+
+    def _start(self, report: AisReport, rows: list[int], z: list[float], var: list[float]) -> Track:
+        """A track from its first report: the measured states at their values and variances.
+
+        States the report does not carry start at the broad prior :data:`AIS_PRIOR_VAR` (course
+        unknown, speed and turn rate about 0, cross-section from the static data when known).
+        """
+        x = np.zeros(ekf.N_STATES)
+        p = np.diag(AIS_PRIOR_VAR)
+        x[rows] = z
+        p[rows, rows] = var
+        static = self.static.get(report.mmsi)
+        if static is not None and np.isfinite(static.length_m * static.beam_m):
+            x[ekf.ALPHA] = static.length_m * static.beam_m
+        t = float(report.time_s)
+        return Track(next(self._ids), "ais", x, p, t, t, t, confirmed=True, n_updates=1, mmsi=report.mmsi,
+                     process=self.config.process)
 
     def set_static(self, static: dict[int, AisStatic]) -> None:
         self.static.update(static)

@@ -84,3 +84,38 @@ def test_filter_is_consistent_on_its_own_model():
                 e = x[:2] - truth[:2]
                 nees.append(e @ np.linalg.solve(p[:2, :2], e))
     assert 1.6 < np.mean(nees) < 2.6  # ideal 2 (2-D position)
+
+
+def _van_loan(a: np.ndarray, qc: np.ndarray, dt: float) -> np.ndarray:
+    """Van Loan (1978): expm([[-A, Qc], [0, A^T]] dt) = [[., F^-1 Qd], [0, F^T]]."""
+    from scipy.linalg import expm
+
+    n = a.shape[0]
+    m = np.zeros((2 * n, 2 * n))
+    m[:n, :n], m[:n, n:], m[n:, n:] = -a, qc, a.T
+    e = expm(m * dt)
+    f = e[n:, n:].T
+    return f @ e[:n, n:]
+
+
+@pytest.mark.parametrize("dt", [0.1, 2.5, 10.0])
+def test_process_noise_is_the_van_loan_discretisation(dt):
+    q = ekf.ProcessNoise()
+    x = np.array([10.0, -5.0, np.radians(40.0), 6.0, np.radians(0.5), 300.0])
+    expected = _van_loan(ekf.continuous_dynamics(x), ekf.noise_density(q), dt)
+    np.testing.assert_allclose(ekf.process_covariance(x, dt, q), expected, rtol=1e-9, atol=1e-12)
+
+
+def test_speed_noise_grows_the_along_track_position_over_an_ais_gap():
+    """Only speed noise, due north at 5 m/s: 10 s grows the north variance by q dt^3 / 3 (6.7 m^2)."""
+    q = ekf.ProcessNoise(position_m2_per_s=0.0, course_rad2_per_s=0.0, speed_m2_per_s3=0.02,
+                         turn_rate_rad2_per_s3=0.0, cross_section_m4_per_s=0.0)
+    x = np.array([0.0, 0.0, 0.0, 5.0, 0.0, 0.0])
+    qd = ekf.process_covariance(x, 10.0, q)
+    assert qd[ekf.N, ekf.N] == pytest.approx(0.02 * 10.0**3 / 3.0)  # 6.67 m^2, not the 0 of a per-state Q
+    assert qd[ekf.E, ekf.E] == pytest.approx(0.0, abs=1e-12)
+    assert qd[ekf.N, ekf.U] == pytest.approx(0.02 * 10.0**2 / 2.0)
+    # a turn-rate noise grows the cross-track one as u^2 q dt^5 / 20
+    q_turn = ekf.ProcessNoise(position_m2_per_s=0.0, course_rad2_per_s=0.0, speed_m2_per_s3=0.0,
+                              turn_rate_rad2_per_s3=1e-4, cross_section_m4_per_s=0.0)
+    assert ekf.process_covariance(x, 10.0, q_turn)[ekf.E, ekf.E] == pytest.approx(25.0 * 1e-4 * 1e5 / 20.0)

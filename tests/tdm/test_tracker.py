@@ -136,3 +136,16 @@ def test_ais_tracks_are_kept_by_mmsi():
     assert tracks[257000001].x[ekf.U] == pytest.approx(5.0, abs=0.2)
     tracker.expire(90.0 + 201.0)
     assert tracker.confirmed_tracks() == []
+
+
+@pytest.mark.parametrize("range_m", [700.0, 1700.0, 5000.0, 10000.0])
+def test_an_ais_track_starts_at_its_first_report(range_m):
+    """Not pulled toward the ENU origin by a prior there (0.948 x the report before: 37 m off at 700 m)."""
+    tracker = AisTracker(AisTrackerConfig())
+    position = np.array([range_m * np.sin(np.radians(40.0)), range_m * np.cos(np.radians(40.0))])
+    tracker.process(AisReport(3.0, 257000009, position, 120.0, 6.0, 121.0, 0.0, 1))
+    (track,) = tracker.confirmed_tracks()
+    assert np.hypot(*(track.x[:2] - position)) < 0.5
+    assert np.degrees(track.x[2]) % 360.0 == pytest.approx(120.0)
+    assert track.x[3] == pytest.approx(6.0)
+    assert track.p[0, 0] == pytest.approx(AisTrackerConfig().position_var_m2)  # the report's own variance
