@@ -40,7 +40,8 @@ FOAM_REFLECTANCE = 0.25  # whitecap foam at 905 nm, diffuse (unverified; bright 
 class Firings:
     """What the sensor measured in a chunk of C firing cycles.
 
-    ``returns`` is 1 (strongest or last) or 2 (dual: [last, strongest]).
+    ``returns`` is 1 (strongest or last) or 2 (dual: [last, strongest], the second-strongest in
+    place of the strongest when the strongest is the last: :func:`raysim.sensors.lidar_physics.dual_pick`).
     distance_units, reflectivity, object_id, source: (C, returns, 32).
     """
 
@@ -263,8 +264,9 @@ class LidarRenderer:
             cand_p[has, k] = phys.echo_power(np.full(has.sum(), phys.FALSE_ECHO_REFLECTANCE), r_false[has], self.alpha)
             cand_b[has, k] = round(100 * phys.FALSE_ECHO_REFLECTANCE)
             cand_src[has, k] = SOURCE_WEATHER
-        strongest, last, group_r, group_id = phys.select_echoes(cand_r, cand_p, self.threshold)
-        picks = [last, strongest] if self.dual else [last if self.cfg.return_mode == "last" else strongest]
+        echoes = phys.select_echoes(cand_r, cand_p, self.threshold)
+        strongest, last, group_r, group_id = echoes.strongest, echoes.last, echoes.group_range, echoes.group
+        picks = [last, phys.dual_pick(echoes)] if self.dual else [last if self.cfg.return_mode == "last" else strongest]
         n_ret = len(picks)
         units = np.zeros((n_ret, f), dtype=np.uint16)
         refl = np.zeros((n_ret, f), dtype=np.uint8)
@@ -283,7 +285,7 @@ class LidarRenderer:
             refl[i, rows] = cand_b[rows, cols]
             oid[i, rows] = cand_id[rows, cols]
             src[i, rows] = cand_src[rows, cols]
-        if self.dual:  # one echo group: both blocks carry the same measurement
+        if self.dual:  # a single echo group: both blocks carry the same measurement
             rows = np.arange(f)
             same = (group_id[rows, np.maximum(picks[0], 0)] == group_id[rows, np.maximum(picks[1], 0)]) & (units[0] > 0)
             units[1] = np.where(same, units[0], units[1])

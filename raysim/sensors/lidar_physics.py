@@ -18,9 +18,15 @@ All of it is vectorised over firings; every constant is a parameter with its sou
 - Reflectivity byte (firmware >= 2.0, docs/reference.md section 2): diffuse surfaces
   0..100 = 100 x the apparent reflectance ``rho cos(theta)``; retro-reflectors
   101..255, growing with ``cos(theta)``.
+- Echoes of a firing (:func:`select_echoes`): candidates closer than :data:`ECHO_MERGE_M` form one
+  echo; the strongest, the last and the second-strongest echo are picked. Dual-return mode reports
+  the last and the strongest, or, when the strongest is also the last, the last and the
+  second-strongest (Velodyne HDL-32E user manual, dual return mode: :func:`dual_pick`).
 """
 
 from __future__ import annotations
+
+from typing import NamedTuple
 
 import numpy as np
 
@@ -63,8 +69,30 @@ def reflectivity_byte(reflectance: np.ndarray, cos_incidence: np.ndarray, retro:
     return np.where(retro, retro_value, diffuse).astype(np.uint8)
 
 
-def select_echoes(range_m: np.ndarray, power: np.ndarray, threshold: float):
-    """Group candidate echoes of each firing and pick the strongest and the last.
+class Echoes(NamedTuple):
+    """The echoes picked from each firing's candidates (:func:`select_echoes`).
+
+    Attributes
+    ----------
+    strongest, last, second : (N,) int64
+        Index of the representative candidate of the strongest, the last and the
+        second-strongest detected echo group; -1 where there is none (``second``: fewer than
+        two detected groups).
+    group_range : (N, E) float64
+        Power-weighted mean range of each candidate's group, m; inf where no candidate.
+    group : (N, E) int64
+        Group id of each candidate (two picks are one echo when their ids agree).
+    """
+
+    strongest: np.ndarray
+    last: np.ndarray
+    second: np.ndarray
+    group_range: np.ndarray
+    group: np.ndarray
+
+
+def select_echoes(range_m: np.ndarray, power: np.ndarray, threshold: float) -> Echoes:
+    """Group candidate echoes of each firing and pick the strongest, the last and the second-strongest.
 
     Parameters
     ----------
@@ -77,19 +105,15 @@ def select_echoes(range_m: np.ndarray, power: np.ndarray, threshold: float):
 
     Returns
     -------
-    strongest, last : (N,) int64
-        Index of the representative candidate of the strongest and of the last detected
-        echo group, -1 where nothing is detected.
-    group_range : (N, E) float64
-        Power-weighted mean range of each candidate's group.
-    group : (N, E) int64
-        Group id of each candidate (strongest and last are one echo when their ids agree).
+    Echoes
+        ``strongest``, ``last``, ``second`` (N,) candidate indices (-1: none), ``group_range``
+        (N, E) m and ``group`` (N, E) ids.
     """
     n, e = range_m.shape
     if e == 1:
         detected = np.isfinite(range_m[:, 0]) & (power[:, 0] >= threshold)
         index = np.where(detected, 0, -1)
-        return index, index.copy(), range_m.copy(), np.zeros((n, 1), np.int64)
+        return Echoes(index, index.copy(), np.full(n, -1, np.int64), range_m.copy(), np.zeros((n, 1), np.int64))
     finite = np.isfinite(range_m)
     p = np.where(finite, power, 0.0)
     r = np.where(finite, range_m, 0.0)
@@ -110,7 +134,25 @@ def select_echoes(range_m: np.ndarray, power: np.ndarray, threshold: float):
     strongest = np.argmax(np.where(detected, group_power, -1.0), axis=1)
     last = np.argmax(np.where(detected, r, -1.0), axis=1)
     anything = detected.any(axis=1)
-    return np.where(anything, strongest, -1), np.where(anything, last, -1), np.where(finite, group_range, np.inf), gid
+    # the second-strongest: the strongest of the detected groups other than the strongest's
+    other = detected & (gid != np.take_along_axis(gid, strongest[:, None], axis=1))
+    second = np.argmax(np.where(other, group_power, -1.0), axis=1)
+    return Echoes(np.where(anything, strongest, -1), np.where(anything, last, -1),
+                  np.where(other.any(axis=1), second, -1), np.where(finite, group_range, np.inf), gid)
+
+
+def dual_pick(echoes: Echoes) -> np.ndarray:
+    """The echo of the dual-return mode's odd (strongest) block, (N,) candidate index or -1.
+
+    The HDL-32E reports the last echo in the even block and the strongest in the odd one; "if
+    the strongest return is also the last return, the second-strongest return is reported"
+    (Velodyne HDL-32E user manual, dual return mode). With a single echo this is the last echo
+    itself (both blocks carry it).
+    """
+    rows = np.arange(echoes.last.shape[0])
+    strongest_is_last = (echoes.group[rows, np.maximum(echoes.strongest, 0)]
+                         == echoes.group[rows, np.maximum(echoes.last, 0)])
+    return np.where(strongest_is_last & (echoes.second >= 0), echoes.second, echoes.strongest)
 
 
 def sub_ray_offsets(count: int, divergence_rad: float) -> np.ndarray:

@@ -312,3 +312,50 @@ def test_position_packets_carry_the_own_ship_gprmc(write_scenario, tmp_path):
         lon = int(fields[5][:3]) + float(fields[5][3:]) / 60
         assert (lat, lon) == pytest.approx(tuple(ORIGIN), abs=1e-6) and fields[4] == "N" and fields[6] == "E"
         assert fields[9] == "010617"
+
+
+def test_select_echoes_picks_the_second_strongest_when_the_strongest_is_last():
+    """Two echoes along a ray, the farther one stronger (fog backscatter at 4 m, a wall at 20 m)."""
+    from raysim.sensors import lidar_physics as phys
+
+    threshold = phys.detection_threshold(0.1)
+    rng = np.array([[4.0, 20.0], [4.0, 20.0], [20.0, np.inf], [20.0, 20.1]])
+    power = np.array([[phys.echo_power(0.02, 4.0, 0.0), phys.echo_power(0.8, 20.0, 0.0)],  # 1.25e-3 < 2e-3
+                      [phys.echo_power(0.10, 4.0, 0.0), phys.echo_power(0.8, 20.0, 0.0)],  # 6.25e-3 > 2e-3
+                      [phys.echo_power(0.8, 20.0, 0.0), 0.0],  # one echo
+                      [1e-3, 1e-3]])  # two sub-rays 0.1 m apart: one echo
+    echoes = phys.select_echoes(rng, power, threshold)
+    assert echoes.strongest.tolist() == [1, 0, 0, 0] and echoes.last.tolist() == [1, 1, 0, 1]
+    assert echoes.second.tolist() == [0, 1, -1, -1]
+    # the odd block: the second-strongest when the strongest is the last, else the strongest; one echo: itself
+    odd = phys.dual_pick(echoes)
+    assert odd.tolist() == [0, 0, 0, 0]
+    assert echoes.group[3, odd[3]] == echoes.group[3, echoes.last[3]]
+
+
+def test_dual_mode_reports_the_second_strongest_when_the_strongest_is_last(write_scenario, tmp_path):
+    """A dark post (rubber, 0.05) 9.5 m ahead of a bright wall (snow, 0.80) at 12.5 m, 7 sub-rays.
+
+    Wherever a beam meets both, the wall is the last echo and the stronger one (at least 1 sub-ray of
+    7 on the wall: 0.8 cos / 12.6^2 / 7 > 5e-4; at most 6 on the post: 0.05 / 9.5^2 x 6/7 < 5e-4), so
+    the odd block carries the second-strongest echo, the post (HDL-32E manual, dual return mode):
+    the post is a second return (``return_index`` 1) and the wall never is. A beam meeting one echo
+    only gives one point (both blocks carry it).
+    """
+    post = {"name": "post", "kind": "mesh", "mesh": box_file(tmp_path, "post", (1.0, 1.0, 20.0), (0, 0, 5)),
+            "position": latlon(0, 10.0), "material": "rubber"}
+    back = {**wall(tmp_path, 12.5, "back"), "material": "snow"}
+    data = scenario(tmp_path, obstacles=[post, back], lidar={"return_mode": "dual", "sub_rays": 7,
+                                                             "beam_divergence_mrad": 10.0})
+    d = sweeps(render(write_scenario, tmp_path, data))[0]
+    second = d["return_index"] == 1
+    assert not (second & (d["object_id"] == 2)).any()  # the wall is always the last echo
+    assert (second & (d["object_id"] == 1)).sum() > 20  # the post behind the stronger wall echo: reported
+    # each such firing (time, ring) also has the wall as its last echo, in the even block
+    firing = np.stack([np.round(d["time"] * 1e7), d["ring"]], 1)
+    last_wall = {tuple(f) for f in firing[(~second) & (d["object_id"] == 2)]}
+    pairs = [tuple(f) in last_wall for f in firing[second & (d["object_id"] == 1)]]
+    assert sum(pairs) > 20 and np.mean(pairs) > 0.9
+    # one echo per firing elsewhere: no firing has two points of the wall
+    wall_firings = firing[d["object_id"] == 2]
+    assert np.unique(wall_firings, axis=0).shape[0] == wall_firings.shape[0]
