@@ -14,10 +14,16 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["NAV_STATUS", "position_report", "class_b_report", "rot_code", "static_report", "static_report_b",
-           "ais_text"]
+__all__ = ["NAV_STATUS", "UNIT_MODEL_CODE", "VENDOR_ID", "position_report", "class_b_report", "rot_code",
+           "static_report", "static_report_b", "unit_serial", "ais_text"]
 
 NAV_STATUS = {"under_way": 0, "at_anchor": 1, "moored": 5}
+#: Message 24 part B's 42-bit vendor ID (ITU-R M.1371-5, message 24 and Annex 7): the manufacturer's
+#: ID, 3 six-bit characters (18 bits; "RAYSIM" would be cut to "RAY"), then the unit model code
+#: (4 bits, 0..15) and the unit serial number (20 bits, 0..1048575).
+VENDOR_ID = "RSM"
+UNIT_MODEL_CODE = 1
+SERIAL_MAX = (1 << 20) - 1
 SOG_MAX_KN = 102.2  # 1022: 102.2 kn or more; 1023 = not available
 AIS_CHARS = "@ABCDEFGHIJKLMNOPQRSTUVWXYZ[\\]^_ !\"#$%&'()*+,-./0123456789:;<=>?"
 
@@ -112,10 +118,20 @@ def static_report(mmsi: int, name: str, call_sign: str | None, ship_type: int, l
             "draught": round(min(max(draught_m, 0.0), 25.5), 1), "destination": ais_text(destination, 20), "dte": 0}
 
 
+def unit_serial(mmsi: int) -> int:
+    """The transponder's serial number in message 24 part B: the MMSI's last six digits (fit 20 bits)."""
+    return int(mmsi) % 1_000_000
+
+
 def static_report_b(mmsi: int, part: int, name: str, call_sign: str | None, ship_type: int, length_m: float,
                     beam_m: float) -> dict:
-    """Fields of a type 24 static data report, part A (0: name) or B (1: type, call sign, dimensions)."""
+    """Fields of a type 24 static data report, part A (0: name) or B (1: type, vendor ID, call sign, dimensions).
+
+    Part B's vendor ID: manufacturer :data:`VENDOR_ID`, unit model :data:`UNIT_MODEL_CODE`, serial
+    number :func:`unit_serial` (pyais's ``vendorid``, ``model`` and ``serial`` fields).
+    """
     if part == 0:
         return {"msg_type": 24, "repeat": 0, "mmsi": mmsi, "partno": 0, "shipname": ais_text(name, 20)}
-    return {"msg_type": 24, "repeat": 0, "mmsi": mmsi, "partno": 1, "ship_type": int(ship_type), "vendorid": "RAYSIM",
-            "model": 0, "serial": 0, "callsign": ais_text(call_sign, 7), **_dimensions(length_m, beam_m)}
+    return {"msg_type": 24, "repeat": 0, "mmsi": mmsi, "partno": 1, "ship_type": int(ship_type), "vendorid": VENDOR_ID,
+            "model": UNIT_MODEL_CODE, "serial": unit_serial(mmsi), "callsign": ais_text(call_sign, 7),
+            **_dimensions(length_m, beam_m)}

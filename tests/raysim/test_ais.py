@@ -122,6 +122,8 @@ def test_render_writes_decodable_nmea_from_the_right_ships(write_scenario, tmp_p
     assert {m.msg_type for _, m in decoded if m.mmsi == 257000003} == {18, 24}
     assert {m.status for _, m in decoded if m.mmsi == 257000002 and m.msg_type in (1, 3)} == {1}  # at anchor
     assert {m.status for _, m in decoded if m.mmsi == 257000001 and m.msg_type in (1, 3)} == {0}  # under way
+    part_b = {(m.vendorid, m.model, m.serial) for _, m in decoded if m.msg_type == 24 and m.partno == 1}
+    assert part_b == {("RSM", 1, 3)}  # manufacturer, unit model, serial (the MMSI's last six digits)
     statics = [m for _, m in decoded if m.msg_type == 5 and m.mmsi == 257000001]
     assert statics[0].shipname == "CARGO" and statics[0].to_bow + statics[0].to_stern == 40
     channels = [line.split(",")[4] for line in (tmp_path / "rec" / "ais" / "ais.nmea").read_text().splitlines()]
@@ -311,3 +313,23 @@ def test_the_thesis_noise_parameters_are_accepted_as_named_there(write_scenario)
                          noise={"AIS_SOG_measure_variance_knots2": 0.5, "sog_measure_variance_knots2": 0.4})
     path = write_scenario(data, "twice.yaml")
     assert main(["render", str(path), "-o", str(path.parent / "out")]) == 2
+
+
+def test_message_24_part_b_vendor_id_is_manufacturer_model_and_serial_as_itu_lays_them_out():
+    """ITU-R M.1371-5 message 24 part B: the 42-bit vendor ID is 18 bits of manufacturer's ID (3 six-bit
+    characters), 4 bits of unit model code, 20 bits of serial number; "RAYSIM" used to be cut to "RAY"."""
+    data = fields.static_report_b(257123456, 1, "yacht", "LA1234", 37, 10.0, 4.0)
+    sentences = encode_dict(data, radio_channel="B", talker_id="AI")
+    m = decode(*sentences)
+    assert (m.msg_type, m.partno, m.mmsi) == (24, 1, 257123456)
+    assert (m.vendorid, m.model, m.serial) == ("RSM", 1, 123456) == (fields.VENDOR_ID, fields.UNIT_MODEL_CODE,
+                                                                       fields.unit_serial(257123456))
+    assert (m.callsign, m.ship_type, m.to_bow + m.to_stern, m.to_port + m.to_starboard) == ("LA1234", 37, 10, 4)
+    # the bits themselves: payload characters to six-bit values, the vendor ID at bits 48..89
+    payload = sentences[0].split(",")[5]
+    bits = "".join(format((ord(c) - 48) - (8 if ord(c) - 48 > 40 else 0), "06b") for c in payload)
+    six_bit = {c: i for i, c in enumerate(fields.AIS_CHARS)}
+    assert bits[48:66] == "".join(format(six_bit[c], "06b") for c in "RSM")
+    assert int(bits[66:70], 2) == 1 and int(bits[70:90], 2) == 123456
+    # every MMSI's serial fits the 20-bit field
+    assert fields.unit_serial(999_999_999) == 999_999 <= fields.SERIAL_MAX
