@@ -40,7 +40,7 @@ from pathlib import Path
 import yaml
 
 from raysim.errors import InputError
-from raysim.recording.staging import atomic_path
+from raysim.recording.staging import atomic_path, is_write_fault, write_fault
 from raysim.scenario import Scenario, load_scenario, scenario_to_yaml, with_overrides
 
 __all__ = ["METRIC_COLUMNS", "RunSpec", "execute_run", "parse_vary", "plan_batch", "run_batch", "write_summary"]
@@ -190,8 +190,10 @@ def execute_run(spec: RunSpec, batch_dir: str) -> dict:
     """Render, run the TDM and evaluate one run (a Dask task); its row, also written to ``results/``.
 
     Never raises for a failure of the run itself: the row says ``failed`` with the error, and the
-    traceback goes to ``results/<run>.log``. The TDM runs in the task's own process (no front-end
-    workers: the batch's parallelism is across runs).
+    traceback goes to ``results/<run>.log``. A write fault (full disk, ...: an ``OSError`` of
+    :data:`raysim.recording.staging.WRITE_ERRNOS`) is returned at once as the row's ``write_errno``,
+    nothing more written: it stops the batch (:func:`run_batch`). The TDM runs in the task's own
+    process (no front-end workers: the batch's parallelism is across runs).
     """
     from raysim.runner import render_detect_evaluate
 
@@ -207,6 +209,8 @@ def execute_run(spec: RunSpec, batch_dir: str) -> dict:
         log.unlink(missing_ok=True)
     except Exception as exc:  # a failed run is recorded and the batch goes on
         row.update(status="failed", error=_one_line(exc))
+        if is_write_fault(exc):  # but not on a full disk: every run would fail the same way
+            return {**row, "write_errno": exc.errno}
         with atomic_path(log) as tmp:
             tmp.write_text(traceback.format_exc(), encoding="utf-8")
     row["wall_s"] = round(time.perf_counter() - started, 3)
@@ -303,7 +307,11 @@ def run_batch(runs: list[RunSpec], batch_dir: Path, scheduler: str | None = None
                 try:
                     row = future.result()
                 except Exception as exc:  # the task itself was lost (worker died, cannot be sent, ...)
+                    if is_write_fault(exc):  # a full disk stops the batch (raysim's one-line error)
+                        raise write_fault(exc, batch_dir) from None
                     row = {**_row(spec), "status": "failed", "error": _one_line(exc)}
+                if row.get("write_errno"):
+                    raise write_fault(OSError(row["write_errno"], os.strerror(row["write_errno"])), batch_dir)
                 rows[spec.name] = row
                 write_summary([rows[s.name] for s in runs if s.name in rows], batch_dir, runs)
                 detail = f"GOSPA {row['gospa_m']:.1f} m" if row["status"] == "ok" and row.get("gospa_m") is not None \

@@ -1,13 +1,16 @@
 """The ``raysim`` command: it only wires (docs/contracts.md "Command line").
 
 Bad input of any kind prints one line ``error: <file>: <place>: <what>`` on
-stderr and exits with code 2, leaving nothing behind.
+stderr and exits with code 2, leaving nothing behind. So does an output that cannot
+be written (a full disk: ``error: <directory>: writing: no space left on device``).
+Ctrl-C exits with code 130 and SIGTERM with 143, after the same cleanup.
 """
 
 from __future__ import annotations
 
 import argparse
 import math
+import os
 import sys
 from pathlib import Path
 
@@ -182,9 +185,12 @@ def cmd_batch(args) -> int:
     try:
         rows = run_batch(runs, args.out, scheduler=args.scheduler, workers=args.workers,
                          progress=progress_printer(not args.no_progress))
-    except KeyboardInterrupt:
-        print("error: interrupted; the finished runs are kept: the same command goes on from there", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:
+        from raysim.recording.staging import EXIT_INTERRUPTED, EXIT_TERMINATED, Terminated
+
+        how = "terminated" if isinstance(exc, Terminated) else "interrupted"
+        print(f"error: {how}; the finished runs are kept: the same command goes on from there", file=sys.stderr)
+        return EXIT_TERMINATED if isinstance(exc, Terminated) else EXIT_INTERRUPTED
     failed = [r for r in rows if r["status"] != "ok"]
     print(f"batch of {len(rows)} runs in {args.out}: {len(rows) - len(failed)} ok, {len(failed)} failed; "
           f"summary in {args.out / 'summary.csv'}")
@@ -329,16 +335,34 @@ COMMANDS = {"render": cmd_render, "run": cmd_run, "batch": cmd_batch, "import-hi
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``raysim`` console script."""
+    """Entry point of the ``raysim`` console script.
+
+    Exit codes: 0 done, 1 a batch with failed runs, 2 bad input or an output that cannot be
+    written (full disk, quota, read-only, I/O error), 130 Ctrl-C, 143 SIGTERM; the last four print
+    one line ``error: ...`` on stderr and leave no staging directory behind.
+    """
+    from raysim.recording.staging import (EXIT_INTERRUPTED, EXIT_TERMINATED, OutputWriteError, Terminated,
+                                          is_write_fault, sigterm_as_interrupt)
+
+    args = None
     try:
-        args = build_parser().parse_args(argv)
-        return COMMANDS[args.command](args)
+        with sigterm_as_interrupt():
+            args = build_parser().parse_args(argv)
+            return COMMANDS[args.command](args)
     except InputError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print("error: interrupted; nothing was written", file=sys.stderr)
-        return 130
+    except OSError as exc:
+        if not is_write_fault(exc):
+            raise
+        where = exc.directory if isinstance(exc, OutputWriteError) else getattr(args, "out", None) or exc.filename
+        text = exc.strerror or os.strerror(exc.errno)
+        print(f"error: {where}: writing: {text[:1].lower() + text[1:]}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt as exc:
+        how = "terminated" if isinstance(exc, Terminated) else "interrupted"
+        print(f"error: {how}; nothing was written", file=sys.stderr)
+        return EXIT_TERMINATED if isinstance(exc, Terminated) else EXIT_INTERRUPTED
 
 
 if __name__ == "__main__":  # pragma: no cover
