@@ -1,9 +1,12 @@
 """Scenario files: the native YAML format of docs/scenario.md, loaded strictly into typed objects.
 
-``load_scenario(path)`` parses with ``yaml.safe_load`` only, validates every key
-(unknown keys, wrong types, NaN/inf and out-of-range values are errors naming the
-key path), checks that referenced files exist, and returns a :class:`Scenario`
-whose derived defaults are filled in (:func:`resolve`). ``dump_scenario`` writes
+``load_scenario(path)`` parses with :func:`raysim.yaml_loader.read_yaml` (safe constructors
+only; keys given twice, alias bombs and deep nesting refused), validates every key
+(unknown keys, wrong types, NaN/inf, float32-collapsing and out-of-range values are errors
+naming the key path), checks that referenced files are regular files
+(:mod:`raysim.input_files`) and the cross-field rules (:mod:`raysim.scenario_checks`, with the
+limits of :mod:`raysim.limits`), and returns a :class:`Scenario` whose derived defaults are
+filled in (:func:`resolve`). ``dump_scenario`` writes
 the resolved scenario back as YAML (the recording's ``scenario.yaml``).
 
 Every field and its default is listed in docs/scenario.md (generated from this
@@ -25,7 +28,10 @@ import yaml
 
 from raysim import schema
 from raysim.errors import InputError
+from raysim.input_files import MAX_CSV_FILE_BYTES, MAX_MESH_FILE_BYTES, path_check
+from raysim.limits import RESOLVE_CHECK, SIZE_CHECK
 from raysim.schema import Context, param
+from raysim.yaml_loader import read_yaml  # noqa: F401 (raysim.hilsim reads the thesis's files with it)
 
 LatLon = tuple[float, float]
 
@@ -72,15 +78,7 @@ def _mmsi_check(value: int) -> str | None:
     return None
 
 
-def _file_check(value: Path) -> str | None:
-    if not value.is_file():
-        return f"file not found: {value}"
-    try:
-        with open(value, "rb") as handle:
-            handle.read(1)
-    except OSError as exc:
-        return f"cannot read {value}: {exc.strerror}"
-    return None
+_MESH_FILE = path_check("mesh file", MAX_MESH_FILE_BYTES)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -95,7 +93,7 @@ class Environment:
     wind_speed_mps: float = param(5.0, doc="True wind speed, m/s", ge=0, le=70)
     wind_from_deg: float = param(0.0, doc="Direction the wind blows from, compass deg", ge=0, lt=360)
     rain_mm_per_h: float = param(0.0, doc="Rain rate, mm/h (radar attenuation and clutter, LiDAR attenuation)", ge=0, le=300)
-    fog_visibility_m: float | None = param(None, doc="Meteorological visibility in fog, m; null = no fog", gt=0)
+    fog_visibility_m: float | None = param(None, doc="Meteorological visibility in fog, m; null = no fog", gt=0, check=SIZE_CHECK)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -121,12 +119,13 @@ class WaveMotion:
 @dataclass(frozen=True, kw_only=True)
 class OwnShip:
     name: str = param("odin", doc="Own-ship name")
-    length_m: float = param(10.9, doc="Length overall, m (Odin: 10.9 m)", gt=0, le=400)
-    beam_m: float | None = param(None, doc="Beam, m", gt=0, le=80, default_doc="length_m / (3.2 + 0.03 length_m)")
-    mesh: Path | None = param(None, doc="Hull mesh file (body frame, metres); null = generated workboat", check=_file_check)
+    length_m: float = param(10.9, doc="Length overall, m (Odin: 10.9 m)", gt=0, le=400, check=SIZE_CHECK)
+    beam_m: float | None = param(None, doc="Beam, m", gt=0, le=80, check=SIZE_CHECK, default_doc="length_m / (3.2 + 0.03 length_m)")
+    mesh: Path | None = param(None, doc="Hull mesh file (body frame, metres); null = generated workboat", check=_MESH_FILE)
     material: str = param("grp", doc="Material of a mesh file's faces (raysim.materials)")
     route: Route | None = param(None, doc="Waypoint route (one of route / trajectory_csv / position)")
-    trajectory_csv: Path | None = param(None, doc="CSV with t_s, lat, lon, heading_deg[, roll_deg, pitch_deg, heave_m]", check=_file_check)
+    trajectory_csv: Path | None = param(None, doc="CSV with t_s, lat, lon, heading_deg[, roll_deg, pitch_deg, heave_m]",
+                                        check=path_check("trajectory CSV", MAX_CSV_FILE_BYTES))
     position: LatLon | None = param(None, doc="Fixed position [lat, lon], deg", check=_lat_lon_check)
     heading_deg: float = param(0.0, doc="Heading of a fixed own ship, compass deg", ge=0, lt=360)
     motion: WaveMotion = param(default_factory=WaveMotion, doc="Wave-induced roll, pitch and heave")
@@ -147,7 +146,7 @@ class Lidar:
     enabled: bool = param(True, doc="Render this sensor")
     model: Literal["HDL-32E"] = param("HDL-32E", doc="LiDAR model")
     rotation_hz: float = param(10.0, doc="Head rotation rate, Hz (HDL-32E: 5-20)", ge=5, le=20)
-    range_max_m: float = param(100.0, doc="Maximum range, m (HDL-32E: 100 m; encoding limit 131.07 m)", gt=0, le=131.07)
+    range_max_m: float = param(100.0, doc="Maximum range, m (HDL-32E: 100 m; encoding limit 131.07 m)", gt=0, le=131.07, check=SIZE_CHECK)
     range_min_m: float = param(0.05, doc="Minimum range, m (HDL-32E returns from 5 cm; drivers often cut at 0.9 m)", ge=0, le=10)
     range_noise_m: float = param(0.008, doc="Range noise, 1 sigma, m (simulators use 0.007-0.008 m)", ge=0, le=1)
     return_mode: Literal["strongest", "last", "dual"] = param("strongest", doc="Return mode of the packets")
@@ -182,7 +181,8 @@ class Radar:
     beam_az_deg: float = param(5.2, doc="Horizontal -3 dB beam width, deg (18 in dome)", gt=0, le=45)
     beam_el_deg: float = param(25.0, doc="Vertical -3 dB beam width, deg", gt=0, le=90)
     resolve_m: float = param(
-        6.0, doc="Ray spacing across the beam at the range scale (or the horizon if nearer), m", gt=0, le=100)
+        6.0, doc="Ray spacing across the beam at the range scale (or the horizon if nearer), m", gt=0, le=100,
+        check=RESOLVE_CHECK)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -227,8 +227,8 @@ class AisNoise:
 @dataclass(frozen=True, kw_only=True)
 class Ais:
     enabled: bool = param(True, doc="Receive AIS")
-    range_m: float = param(10_000.0, doc="Reception range, m", gt=0, le=200_000)
-    antenna_height_m: float = param(5.0, doc="Height of the own ship's VHF antenna above the sea, m (radio horizon)", gt=0, le=100)
+    range_m: float = param(10_000.0, doc="Reception range, m", gt=0, le=200_000, check=SIZE_CHECK)
+    antenna_height_m: float = param(5.0, doc="Height of the own ship's VHF antenna above the sea, m (radio horizon)", gt=0, le=100, check=SIZE_CHECK)
     radio_horizon: bool = param(True, doc="Limit reception to the VHF radio horizon 4.12 (sqrt(h_tx) + sqrt(h_rx)) km")
     noise: AisNoise = param(default_factory=AisNoise, doc="Transponder error model (thesis section 2.5)")
 
@@ -274,10 +274,10 @@ class Obstacle:
     kind: Literal["iceberg", "buoy", "mesh"] = param(doc="iceberg (generated), buoy (generated) or mesh (a file)")
     position: LatLon = param(doc="Position [lat, lon] of the body origin, deg", check=_lat_lon_check)
     heading_deg: float = param(0.0, doc="Heading of the body x axis, compass deg", ge=0, lt=360)
-    radius_m: float | None = param(None, doc="Iceberg: waterline radius, m", gt=0, le=1000, default_doc="15 m (iceberg)")
-    height_m: float | None = param(None, doc="Iceberg: height above water, m", gt=0, le=200, default_doc="0.5 x radius_m (iceberg)")
+    radius_m: float | None = param(None, doc="Iceberg: waterline radius, m", gt=0, le=1000, check=SIZE_CHECK, default_doc="15 m (iceberg)")
+    height_m: float | None = param(None, doc="Iceberg: height above water, m", gt=0, le=200, check=SIZE_CHECK, default_doc="0.5 x radius_m (iceberg)")
     seed: int | None = param(None, doc="Iceberg: shape seed", ge=0, default_doc="CRC-32 of the name (shape independent of the scenario seed)")
-    mesh: Path | None = param(None, doc="Mesh file for kind mesh (body frame, metres)", check=_file_check)
+    mesh: Path | None = param(None, doc="Mesh file for kind mesh (body frame, metres)", check=_MESH_FILE)
     material: str | None = param(None, doc="Material of a mesh file's faces", default_doc="concrete (mesh)")
 
 
@@ -318,7 +318,7 @@ class ShipAis:
     destination: str | None = param(None, doc="Destination, up to 20 characters; null: not available", check=_ais_text(20))
     nav_status: Literal["auto", "under_way", "at_anchor", "moored"] = param(
         "auto", doc="Navigation status; auto: at anchor when anchored, else under way using engine")
-    antenna_height_m: float | None = param(None, doc="Transmitting antenna height above the sea, m", gt=0, le=100,
+    antenna_height_m: float | None = param(None, doc="Transmitting antenna height above the sea, m", gt=0, le=100, check=SIZE_CHECK,
                                            default_doc="the ship's height")
     dropout_probability: float = param(0.0, doc="Chance that a report is lost (intermittent reception)", ge=0, le=1)
     off_periods_s: tuple[tuple[float, float], ...] = param(
@@ -331,14 +331,14 @@ class ShipAis:
 class Ship:
     name: str = param(doc="Unique name")
     kind: Literal["ship"] = param("ship", doc="Object kind")
-    length_m: float = param(30.0, doc="Length overall, m", gt=0, le=500)
-    beam_m: float | None = param(None, doc="Beam, m", gt=0, le=80, default_doc="length_m / (3.2 + 0.03 length_m)")
+    length_m: float = param(30.0, doc="Length overall, m", gt=0, le=500, check=SIZE_CHECK)
+    beam_m: float | None = param(None, doc="Beam, m", gt=0, le=80, check=SIZE_CHECK, default_doc="length_m / (3.2 + 0.03 length_m)")
     speed_kn: float = param(0.0, doc="Speed, knots (0 with one waypoint = anchored)", ge=0, le=60)
     waypoints: tuple[LatLon, ...] = param(doc="Waypoints [lat, lon], deg", min_items=1, check=_waypoints_check)
     heading_deg: float | None = param(None, doc="Heading of an anchored ship, compass deg", ge=0, lt=360, default_doc="first leg's course, or 0")
     at_end: Literal["continue", "stop", "loop"] = param("continue", doc="After the last waypoint: keep course, stop, or loop")
     heading_time_constant_s: float | None = param(None, doc="First-order heading response time constant, s", gt=0, le=600, default_doc="0.1 s/m x length_m, clipped to [2, 60] s")
-    mesh: Path | None = param(None, doc="Mesh file (body frame, metres); null = generated hull of length_m", check=_file_check)
+    mesh: Path | None = param(None, doc="Mesh file (body frame, metres); null = generated hull of length_m", check=_MESH_FILE)
     material: str | None = param(None, doc="Material of a mesh file's faces (generated hulls: steel, GRP under 15 m)", default_doc="steel_painted (mesh)")
     ais: ShipAis | None = param(None, doc="AIS transponder; null = none")
 
@@ -374,30 +374,6 @@ class Scenario:
 # ---------------------------------------------------------------------------- loading
 
 
-def read_yaml(path: Path) -> object:
-    """Parse a YAML file with ``yaml.safe_load``; any problem is an :class:`InputError` naming the place."""
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise InputError(str(path), "(file)", "file not found") from None
-    except IsADirectoryError:
-        raise InputError(str(path), "(file)", "is a directory, not a scenario file") from None
-    except UnicodeDecodeError as exc:
-        raise InputError(str(path), f"byte {exc.start}", "not a UTF-8 text file") from None
-    except OSError as exc:
-        raise InputError(str(path), "(file)", f"cannot read: {exc.strerror}") from None
-    if not text.strip():
-        raise InputError(str(path), "(file)", "file is empty")
-    try:
-        return yaml.safe_load(text)
-    except yaml.MarkedYAMLError as exc:
-        mark = exc.problem_mark or exc.context_mark
-        where = f"line {mark.line + 1}, column {mark.column + 1}" if mark else "(file)"
-        raise InputError(str(path), where, f"not valid YAML: {exc.problem or exc.context}") from None
-    except yaml.YAMLError as exc:
-        raise InputError(str(path), "(file)", f"not valid YAML: {exc}") from None
-
-
 def load_scenario(path: str | Path, resolve_defaults: bool = True, changes: dict[str, object] | None = None) -> Scenario:
     """Load, validate and (by default) resolve a scenario file.
 
@@ -429,7 +405,9 @@ def load_scenario(path: str | Path, resolve_defaults: bool = True, changes: dict
         data = {"name": path.stem, **data}
     scenario = schema.build(Scenario, data, ctx)
     object.__setattr__(scenario, "source_file", str(path))
-    _validate(scenario, ctx)
+    from raysim.scenario_checks import validate
+
+    validate(scenario, ctx)
     return resolve(scenario) if resolve_defaults else scenario
 
 
@@ -467,94 +445,6 @@ def set_key_path(data: dict, key_path: str, value: object, file: str = "(scenari
                 node = node[part]
         else:
             raise InputError(file, ".".join(parts[:depth]), "holds a single value, not keys to set below it")
-
-
-def _validate(s: Scenario, ctx: Context) -> None:
-    """Checks across fields that a per-field schema cannot express."""
-    from raysim import materials
-
-    own = s.own_ship
-    given = [k for k in ("route", "trajectory_csv", "position") if getattr(own, k) is not None]
-    if len(given) > 1:
-        ctx.fail("own_ship", f"give only one of route, trajectory_csv, position (got {', '.join(given)})")
-    if not given:
-        ctx.fail("own_ship", "needs a route, a trajectory_csv or a position")
-    if own.trajectory_csv is not None:
-        from raysim.trajectory_csv import read_trajectory_csv
-
-        track = read_trajectory_csv(own.trajectory_csv)
-        if track.t_s[-1] < s.duration_s:
-            ctx.fail("own_ship.trajectory_csv", f"covers 0..{track.t_s[-1]:g} s but duration_s is {s.duration_s:g}")
-    _check_material(ctx, "own_ship.material", own.material, materials)
-    names: dict[str, str] = {own.name: "own_ship.name"}
-    for i, obstacle in enumerate(s.obstacles):
-        where = f"obstacles[{i}]"
-        _check_unique(ctx, names, obstacle.name, where + ".name")
-        generated_only = {"radius_m", "height_m", "seed"}
-        if obstacle.kind != "iceberg":
-            for key in sorted(generated_only):
-                if getattr(obstacle, key) is not None:
-                    ctx.fail(f"{where}.{key}", f"only applies to kind iceberg, not {obstacle.kind}")
-        if obstacle.kind == "mesh" and obstacle.mesh is None:
-            ctx.fail(f"{where}.mesh", "required for kind mesh")
-        if obstacle.kind != "mesh":
-            for key in ("mesh", "material"):
-                if getattr(obstacle, key) is not None:
-                    ctx.fail(f"{where}.{key}", f"only applies to kind mesh, not {obstacle.kind}")
-        if obstacle.material is not None:
-            _check_material(ctx, where + ".material", obstacle.material, materials)
-    mmsis: dict[int, str] = {}
-    for i, ship in enumerate(s.ships):
-        where = f"ships[{i}]"
-        _check_unique(ctx, names, ship.name, where + ".name")
-        if ship.material is not None:
-            if ship.mesh is None:
-                ctx.fail(where + ".material", "only applies to a ship with a mesh file (generated hulls bring their own)")
-            _check_material(ctx, where + ".material", ship.material, materials)
-        if ship.ais is not None:
-            if ship.ais.mmsi in mmsis:
-                ctx.fail(where + ".ais.mmsi", f"MMSI {ship.ais.mmsi} is already used by {mmsis[ship.ais.mmsi]}")
-            mmsis[ship.ais.mmsi] = where
-        if len(ship.waypoints) == 1 and ship.speed_kn > 0:
-            ctx.fail(where + ".speed_kn", "a ship with one waypoint is anchored: speed_kn must be 0 (add a waypoint to move)")
-    _check_distances(s, ctx)
-
-
-def _check_unique(ctx: Context, names: dict[str, str], name: str, where: str) -> None:
-    if name in names:
-        ctx.fail(where, f"name {name!r} is already used by {names[name].rsplit('.', 1)[0]}")
-    names[name] = where
-
-
-def _check_material(ctx: Context, where: str, name: str, materials) -> None:
-    try:
-        materials.material_index(name)
-    except KeyError:
-        ctx.fail(where, f"unknown material {name!r} (known: {', '.join(m.name for m in materials.MATERIALS)})")
-
-
-def _check_distances(s: Scenario, ctx: Context) -> None:
-    from raysim.geodesy import LocalFrame
-
-    origin = (s.origin.lat, s.origin.lon) if s.origin else s.own_ship_start()
-    frame = LocalFrame(*origin)
-    places: list[tuple[str, LatLon]] = []
-    if s.own_ship.route:
-        places += [(f"own_ship.route.waypoints[{i}]", wp) for i, wp in enumerate(s.own_ship.route.waypoints)]
-    if s.own_ship.position:
-        places.append(("own_ship.position", s.own_ship.position))
-    places += [(f"obstacles[{i}].position", o.position) for i, o in enumerate(s.obstacles)]
-    for i, ship in enumerate(s.ships):
-        places += [(f"ships[{i}].waypoints[{j}]", wp) for j, wp in enumerate(ship.waypoints)]
-    if not places:
-        return
-    lat = [p[1][0] for p in places]
-    lon = [p[1][1] for p in places]
-    x, y = frame.to_local(lat, lon)
-    for (where, _), xi, yi in zip(places, x, y):
-        distance = math.hypot(xi, yi)
-        if not distance <= MAX_DISTANCE_FROM_ORIGIN_M:
-            ctx.fail(where, f"is {distance / 1000:.1f} km from the origin; a scenario must stay within {MAX_DISTANCE_FROM_ORIGIN_M / 1000:g} km")
 
 
 # ---------------------------------------------------------------------------- defaults
@@ -654,6 +544,11 @@ def with_overrides(s: Scenario, duration_s: float | None = None, seed: int | Non
     """The scenario with command-line overrides applied (values already validated by the CLI)."""
     changes: dict = {}
     if duration_s is not None:
+        from raysim.limits import time_span_problem
+
+        problem = time_span_problem(s.start_time, float(duration_s), "--duration")
+        if problem:
+            raise InputError(s.source_file or "scenario", "start_time", problem)
         changes["duration_s"] = float(duration_s)
     if seed is not None:
         changes["seed"] = int(seed)

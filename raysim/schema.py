@@ -2,8 +2,9 @@
 
 A schema is a dataclass whose fields carry metadata made by :func:`param`:
 a documentation line, a unit-bearing name, bounds and an optional check.
-:func:`build` walks the YAML tree, rejects unknown keys, wrong types, NaN/inf
-and out-of-range values, and raises :class:`raysim.errors.InputError` naming the
+:func:`build` walks the YAML tree, rejects unknown keys, wrong types, NaN/inf,
+numbers that float32 turns into 0, a subnormal or inf, out-of-range values, times no
+``datetime`` holds and symlink loops in paths, and raises :class:`raysim.errors.InputError` naming the
 key path (``ships[1].ais.mmsi``). :func:`to_plain` turns a built object back
 into plain YAML-able data, and :func:`describe` lists every field with its
 default for the documentation.
@@ -13,6 +14,7 @@ from __future__ import annotations
 
 import dataclasses
 import datetime as dt
+import errno
 import math
 import types
 import typing
@@ -24,6 +26,11 @@ from raysim.errors import InputError
 DERIVED = "derived"  # doc marker for defaults computed from other fields
 
 _MISSING = dataclasses.MISSING
+
+#: Smallest normal and largest float32 (``numpy.finfo(numpy.float32)``): every number of a schema must
+#: lie between them (or be 0), since meshes, rays and sweeps are float32.
+FLOAT32_TINY = 1.1754943508222875e-38
+FLOAT32_MAX = 3.4028234663852886e38
 
 
 def param(
@@ -114,6 +121,69 @@ def _check_number(value: float, meta: dict, ctx: Context, path: str) -> None:
             ctx.fail(path, f"must be {word} {bound:g}, got {value:g}")
 
 
+def _exponent_hint(value: Any) -> str:
+    """For ``1e-3`` (a string to YAML 1.1, which wants ``1.0e-3``): how to write it as a number."""
+    if not isinstance(value, str):
+        return ""
+    try:
+        number = float(value)
+    except ValueError:
+        return ""
+    if "e" in value.lower() and "." not in value and math.isfinite(number):
+        mantissa, exponent = value.lower().split("e", 1)
+        return f" (YAML reads {value} as text: write {mantissa}.0e{exponent})"
+    return ""
+
+
+def _check_float32(value: float, ctx: Context, path: str) -> None:
+    """Refuse a number that float32, the renderer's geometry type, turns into 0, a subnormal or inf."""
+    if value != 0.0 and abs(value) < FLOAT32_TINY:
+        ctx.fail(path, f"{value:g} is below {FLOAT32_TINY:.4g}, the smallest normal float32: it would collapse to "
+                       "zero (or lose its precision) in the renderer's float32 arithmetic")
+    if abs(value) > FLOAT32_MAX:
+        ctx.fail(path, f"{value:g} is beyond {FLOAT32_MAX:.4g}, the largest float32")
+
+
+def _to_float(value: Any, meta: dict, ctx: Context, path: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        ctx.fail(path, f"must be a number, got {_type_name(value)}{_exponent_hint(value)}")
+    try:
+        number = float(value)
+    except OverflowError:  # an integer beyond any float
+        ctx.fail(path, f"must be a finite number, got an integer of {len(str(abs(value)))} digits")
+    _check_number(number, meta, ctx, path)
+    _check_float32(number, ctx, path)
+    return number
+
+
+def _to_path(value: Any, ctx: Context, path: str) -> Path:
+    """The absolute path of a path key, relative to the YAML file's folder; a symlink loop is refused."""
+    if not isinstance(value, str) or not value.strip():
+        ctx.fail(path, f"must be a file path, got {_type_name(value)}")
+    try:
+        return (ctx.base_dir / value).resolve()
+    except (RuntimeError, OSError, ValueError) as exc:  # RuntimeError: a symlink loop (Python < 3.13)
+        loop = isinstance(exc, RuntimeError) or getattr(exc, "errno", None) == errno.ELOOP
+        ctx.fail(path, f"symlink loop: {value} leads back to itself" if loop else f"not a usable path: {value!r}")
+
+
+def _to_datetime(value: Any, ctx: Context, path: str) -> dt.datetime:
+    """An aware UTC time from an ISO 8601 string or a YAML timestamp (no zone: UTC)."""
+    if isinstance(value, str):
+        try:
+            value = dt.datetime.fromisoformat(value.replace("Z", "+00:00"))
+        except ValueError:
+            ctx.fail(path, f"must be an ISO 8601 UTC time such as 2017-06-01T12:00:00Z, got {value!r}")
+    if not isinstance(value, dt.datetime):
+        ctx.fail(path, f"must be an ISO 8601 UTC time such as 2017-06-01T12:00:00Z, got {_type_name(value)}")
+    if value.tzinfo is None:
+        value = value.replace(tzinfo=dt.timezone.utc)
+    try:
+        return value.astimezone(dt.timezone.utc)
+    except OverflowError:  # 0001-01-01T00:30:00+01:00 is before year 1 in UTC
+        ctx.fail(path, f"{value.isoformat()} is before 0001-01-01T00:00:00Z, the first time a datetime holds")
+
+
 def _convert(tp: Any, value: Any, meta: dict, ctx: Context, path: str) -> Any:
     origin = get_origin(tp)
     args = get_args(tp)
@@ -162,29 +232,15 @@ def _convert(tp: Any, value: Any, meta: dict, ctx: Context, path: str) -> Any:
         _check_number(value, meta, ctx, path)
         return value
     if tp is float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            ctx.fail(path, f"must be a number, got {_type_name(value)}")
-        _check_number(float(value), meta, ctx, path)
-        return float(value)
+        return _to_float(value, meta, ctx, path)
     if tp is str:
         if not isinstance(value, str) or not value.strip():
             ctx.fail(path, f"must be a non-empty string, got {_type_name(value)}")
         return value
     if tp is Path:
-        if not isinstance(value, str) or not value.strip():
-            ctx.fail(path, f"must be a file path, got {_type_name(value)}")
-        return (ctx.base_dir / value).resolve()
+        return _to_path(value, ctx, path)
     if tp is dt.datetime:
-        if isinstance(value, str):
-            try:
-                value = dt.datetime.fromisoformat(value.replace("Z", "+00:00"))
-            except ValueError:
-                ctx.fail(path, f"must be an ISO 8601 UTC time such as 2017-06-01T12:00:00Z, got {value!r}")
-        if not isinstance(value, dt.datetime):
-            ctx.fail(path, f"must be an ISO 8601 UTC time such as 2017-06-01T12:00:00Z, got {_type_name(value)}")
-        if value.tzinfo is None:
-            value = value.replace(tzinfo=dt.timezone.utc)
-        return value.astimezone(dt.timezone.utc)
+        return _to_datetime(value, ctx, path)
     if tp is Any:
         return value
     raise TypeError(f"schema type {tp!r} at {path} is not supported")  # a bug in a schema, not bad input

@@ -3,13 +3,16 @@
 A header line naming the columns is required (any order; extra columns are an
 error). Times start at 0 or later and increase strictly; angles are degrees in the
 marine convention (roll positive starboard down, pitch positive bow up), heave
-metres positive up. Bad content raises :class:`raysim.errors.InputError` naming
+metres positive up (roll and pitch within 90 deg, heave within 50 m). Consecutive samples
+may not be further apart than a vessel sails (:data:`raysim.limits.MAX_SPEED_MPS`, 60 m/s,
+plus 1 m of position jitter). Bad content raises :class:`raysim.errors.InputError` naming
 the line.
 """
 
 from __future__ import annotations
 
 import csv
+import io
 import math
 from dataclasses import dataclass
 from functools import lru_cache
@@ -18,6 +21,8 @@ from pathlib import Path
 import numpy as np
 
 from raysim.errors import InputError
+from raysim.input_files import MAX_CSV_FILE_BYTES, file_problem, read_text_file
+from raysim.limits import MAX_SPEED_MPS, fastest_step, speed_text
 
 REQUIRED = ("t_s", "lat", "lon", "heading_deg")
 OPTIONAL = ("roll_deg", "pitch_deg", "heave_m")
@@ -34,11 +39,23 @@ class TrajectoryTable:
     roll_deg: np.ndarray | None
     pitch_deg: np.ndarray | None
     heave_m: np.ndarray | None
+    line: np.ndarray | None = None  # (K,) line number of each sample in the file
 
 
 def read_trajectory_csv(path: str | Path) -> TrajectoryTable:
-    """Read and validate a trajectory CSV (cached per path and modification time)."""
+    """Read and validate a trajectory CSV (cached per path and modification time).
+
+    Raises
+    ------
+    InputError
+        Naming the file and the line: not a regular file (a FIFO, socket, device or symlink loop
+        is refused without blocking), not UTF-8, bad header or values, times not increasing, or
+        a step faster than :data:`raysim.limits.MAX_SPEED_MPS`.
+    """
     path = Path(path)
+    problem = file_problem(path, "trajectory CSV", MAX_CSV_FILE_BYTES)
+    if problem is not None:
+        raise InputError(str(path), "(file)", problem)
     try:
         stamp = path.stat().st_mtime_ns
     except OSError:
@@ -46,14 +63,11 @@ def read_trajectory_csv(path: str | Path) -> TrajectoryTable:
     return _read(str(path), stamp)
 
 
-@lru_cache(maxsize=8)
-def _read(path: str, _stamp: int) -> TrajectoryTable:
-    try:
-        with open(path, newline="", encoding="utf-8") as handle:
-            rows = list(csv.reader(handle))
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(path, "(file)", f"cannot read as text: {exc}") from None
-    rows = [(i + 1, r) for i, r in enumerate(rows) if r and not r[0].lstrip().startswith("#")]
+def _rows(path: str) -> tuple[list[str], list[int], np.ndarray]:
+    """The header's column names, each data row's line number and the (K, columns) values."""
+    text = read_text_file(path, path, "(file)", MAX_CSV_FILE_BYTES, kind="trajectory CSV")
+    rows = [(i + 1, r) for i, r in enumerate(csv.reader(io.StringIO(text, newline="")))
+            if r and not r[0].lstrip().startswith("#")]
     if not rows:
         raise InputError(path, "(file)", "file is empty")
     header_line, header = rows[0]
@@ -80,13 +94,26 @@ def _read(path: str, _stamp: int) -> TrajectoryTable:
             if not math.isfinite(value):
                 raise InputError(path, f"line {line}", f"{names[j]}: must be finite, got {cell.strip()}")
             data[k, j] = value
+    return names, [line for line, _ in rows[1:]], data
+
+
+#: Column -> (bound on the absolute value, message): roll and pitch past 90 deg capsize, and heave
+#: beyond 50 m is no wave; t_s is checked separately.
+BOUNDS = {
+    "lat": (90.0, "latitude must be within [-90, 90]"),
+    "lon": (180.0, "longitude must be within [-180, 180]"),
+    "roll_deg": (90.0, "must be within [-90, 90] deg"),
+    "pitch_deg": (90.0, "must be within [-90, 90] deg"),
+    "heave_m": (50.0, "must be within [-50, 50] m"),
+}
+
+
+@lru_cache(maxsize=8)
+def _read(path: str, _stamp: int) -> TrajectoryTable:
+    names, lines, data = _rows(path)
     col = {name: data[:, j] for j, name in enumerate(names)}
-    lines = [line for line, _ in rows[1:]]
-    checks = (
-        ("t_s", col["t_s"] < 0, "must be >= 0"),
-        ("lat", np.abs(col["lat"]) > 90, "latitude must be within [-90, 90]"),
-        ("lon", np.abs(col["lon"]) > 180, "longitude must be within [-180, 180]"),
-    )
+    checks = [("t_s", col["t_s"] < 0, "must be >= 0")]
+    checks += [(name, np.abs(col[name]) > bound, message) for name, (bound, message) in BOUNDS.items() if name in col]
     for name, bad, message in checks:
         if bad.any():
             raise InputError(path, f"line {lines[int(np.argmax(bad))]}", f"{name}: {message}")
@@ -95,7 +122,13 @@ def _read(path: str, _stamp: int) -> TrajectoryTable:
         raise InputError(path, f"line {lines[int(np.argmax(step <= 0)) + 1]}", "t_s must increase strictly")
     if col["t_s"][0] > 0:
         raise InputError(path, f"line {lines[0]}", f"the first t_s must be 0, got {col['t_s'][0]:g}")
+    fast = fastest_step(col["t_s"], col["lat"], col["lon"])
+    if fast is not None:
+        k, distance_m, dt_s = fast
+        raise InputError(path, f"line {lines[k]}", f"lat, lon: {speed_text(distance_m, dt_s)} from line {lines[k - 1]}; "
+                                                   f"a vessel does at most {MAX_SPEED_MPS:g} m/s")
     return TrajectoryTable(
         t_s=col["t_s"], lat_deg=col["lat"], lon_deg=col["lon"], heading_deg=col["heading_deg"],
         roll_deg=col.get("roll_deg"), pitch_deg=col.get("pitch_deg"), heave_m=col.get("heave_m"),
+        line=np.asarray(lines, dtype=np.int64),
     )

@@ -16,6 +16,7 @@ import numpy as np
 from raysim import meshes
 from raysim.errors import InputError
 from raysim.geodesy import LocalFrame
+from raysim.limits import check_scene_triangles
 from raysim.motion import Motion, SampledTrack, ShipMotion, Stationary, WaveMotion, TRACK_DT_S, waypoint_track
 from raysim.pose import yaw_from_heading_deg
 from raysim.random_streams import stream
@@ -78,6 +79,7 @@ class World:
         for i, ship in enumerate(scenario.ships):
             objects.append(self._ship(len(objects), i, ship))
         self.objects: tuple[WorldObject, ...] = tuple(objects)
+        check_scene_triangles([(o.key_path, o.mesh.n_triangles) for o in objects], scenario.source_file or "scenario")
 
     @property
     def own_ship(self) -> WorldObject:
@@ -102,7 +104,7 @@ class World:
             try:
                 self._mesh_cache[key] = meshes.load_mesh(path, material=material)
             except meshes.MeshError as exc:
-                raise InputError(self.scenario.source_file or "scenario", where, f"{path}: {exc.message}") from None
+                raise InputError(self.scenario.source_file or "scenario", where, exc.message) from None
         return self._mesh_cache[key]
 
     def _waves(self, cfg: WaveMotionConfig, name: str) -> WaveMotion:
