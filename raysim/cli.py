@@ -346,9 +346,14 @@ def main(argv: list[str] | None = None) -> int:
 
     args = None
     try:
-        with sigterm_as_interrupt():
-            args = build_parser().parse_args(argv)
-            return COMMANDS[args.command](args)
+        with sigterm_as_interrupt() as sigterm:
+            try:
+                args = build_parser().parse_args(argv)
+                return COMMANDS[args.command](args)
+            except Exception as exc:
+                if sigterm.received:  # SIGTERM surfaced as another exception (from a C extension)
+                    raise Terminated() from exc
+                raise
     except InputError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

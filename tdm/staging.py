@@ -32,7 +32,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Iterator
 
-__all__ = ["EXIT_INTERRUPTED", "EXIT_TERMINATED", "OutputWriteError", "StagedOutputs", "Terminated", "WRITE_ERRNOS",
+__all__ = ["EXIT_INTERRUPTED", "EXIT_TERMINATED", "OutputWriteError", "Sigterm", "StagedOutputs", "Terminated", "WRITE_ERRNOS",
            "is_write_fault", "remove_stale", "sigterm_as_interrupt", "write_fault"]
 
 #: ``errno`` values that mean "the output cannot be written": no space left on the device, disk
@@ -73,6 +73,18 @@ class Terminated(KeyboardInterrupt):
     """SIGTERM received: raised in the main thread like Ctrl-C's ``KeyboardInterrupt`` (same cleanup)."""
 
 
+class Sigterm:
+    """What :func:`sigterm_as_interrupt` yields: ``received`` is True once SIGTERM arrived.
+
+    The :class:`Terminated` it raises can come out of a C extension as another exception (an
+    ``ImportError`` when it lands in a module's initialisation): a command that fails after
+    ``received`` was set was terminated, whatever the exception says.
+    """
+
+    def __init__(self) -> None:
+        self.received = False
+
+
 def is_write_fault(exc: BaseException) -> bool:
     """Whether ``exc`` is an ``OSError`` whose ``errno`` is in :data:`WRITE_ERRNOS`."""
     return isinstance(exc, OSError) and exc.errno in WRITE_ERRNOS
@@ -84,15 +96,16 @@ def write_fault(exc: OSError, directory: Path) -> OutputWriteError:
 
 
 @contextmanager
-def sigterm_as_interrupt() -> Iterator[None]:
+def sigterm_as_interrupt() -> Iterator[Sigterm]:
     """While inside, SIGTERM raises :class:`Terminated` in this process's main thread.
 
     A second SIGTERM is ignored so that the cleanup runs to its end (SIGKILL still stops the
     process). Front-end workers forked meanwhile inherit the handler; in them SIGTERM keeps its
     default action. Outside the main thread nothing changes.
     """
+    state = Sigterm()
     if threading.current_thread() is not threading.main_thread():
-        yield
+        yield state
         return
     owner = os.getpid()
 
@@ -102,11 +115,12 @@ def sigterm_as_interrupt() -> Iterator[None]:
             os.kill(os.getpid(), signum)
             return
         signal.signal(signum, signal.SIG_IGN)
+        state.received = True
         raise Terminated()
 
     previous = signal.signal(signal.SIGTERM, handler)
     try:
-        yield
+        yield state
     finally:
         signal.signal(signal.SIGTERM, previous)
 

@@ -86,16 +86,29 @@ class Terminated(KeyboardInterrupt):
     """SIGTERM received: raised in the main thread like Ctrl-C's ``KeyboardInterrupt`` (same cleanup)."""
 
 
+class Sigterm:
+    """What :func:`sigterm_as_interrupt` yields: ``received`` is True once SIGTERM arrived.
+
+    The :class:`Terminated` it raises can come out of a C extension as another exception (an
+    ``ImportError`` when it lands in a module's initialisation): a command that fails after
+    ``received`` was set was terminated, whatever the exception says.
+    """
+
+    def __init__(self) -> None:
+        self.received = False
+
+
 @contextmanager
-def sigterm_as_interrupt() -> Iterator[None]:
+def sigterm_as_interrupt() -> Iterator[Sigterm]:
     """While inside, SIGTERM raises :class:`Terminated` in this process's main thread.
 
     A second SIGTERM is ignored, so the cleanup the first one started runs to its end (SIGKILL
     still stops the process). Worker processes forked meanwhile inherit the handler; in them
     SIGTERM keeps its default action (the process ends). Outside the main thread nothing changes.
     """
+    state = Sigterm()
     if threading.current_thread() is not threading.main_thread():
-        yield
+        yield state
         return
     owner = os.getpid()
 
@@ -105,11 +118,12 @@ def sigterm_as_interrupt() -> Iterator[None]:
             os.kill(os.getpid(), signum)
             return
         signal.signal(signum, signal.SIG_IGN)
+        state.received = True
         raise Terminated()
 
     previous = signal.signal(signal.SIGTERM, handler)
     try:
-        yield
+        yield state
     finally:
         signal.signal(signal.SIGTERM, previous)
 

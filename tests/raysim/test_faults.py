@@ -137,3 +137,22 @@ def test_the_next_run_removes_staging_directories_of_dead_processes_only(tmp_pat
     assert all(not p.exists() for p in stale)
     assert all(p.is_dir() for p in kept) and (runs / f".file.partial-{dead}").is_file()
     assert not (runs / "rec" / ".staging-host").exists()  # the marker never reaches the recording
+
+
+def test_sigterm_that_an_extension_turns_into_another_exception_still_exits_143(tmp_path, monkeypatch, capsys):
+    """SIGTERM landing in a C extension's module initialisation comes out as ImportError (open3d's does)."""
+    import raysim.render
+
+    def render_hit_in_an_import(*args, **kwargs):
+        try:
+            os.kill(os.getpid(), signal.SIGTERM)
+        except KeyboardInterrupt as exc:
+            raise ImportError("initialization failed") from exc
+        raise AssertionError("SIGTERM did not arrive")
+
+    monkeypatch.setattr(raysim.render, "render", render_hit_in_an_import)
+    previous = signal.getsignal(signal.SIGTERM)
+    assert main(["render", str(BUSY), "-o", str(tmp_path / "rec"), "--no-progress"]) == 143
+    assert signal.getsignal(signal.SIGTERM) == previous
+    captured = capsys.readouterr()
+    assert captured.err.splitlines() == ["error: terminated; nothing was written"] and captured.out == ""

@@ -94,3 +94,20 @@ def test_tdm_run_removes_the_staging_of_a_killed_run_and_writes_its_files_togeth
     assert not dead.exists() and alive.is_dir()
     assert sorted(p.name for p in (rec / "tdm").iterdir()) == ["detected_targets.jsonl", "metrics.json", "notes.txt",
                                                                 "sensor_tracks.jsonl"]
+
+
+def test_sigterm_that_an_extension_turns_into_another_exception_still_exits_143(recording, monkeypatch, capsys):
+    import tdm.pipeline
+
+    def run_hit_in_an_import(*args, **kwargs):
+        try:
+            os.kill(os.getpid(), signal.SIGTERM)
+        except KeyboardInterrupt as exc:
+            raise ImportError("initialization failed") from exc
+        raise AssertionError("SIGTERM did not arrive")
+
+    monkeypatch.setattr(tdm.pipeline, "run_tdm", run_hit_in_an_import)
+    assert main(["run", str(recording), "--workers", "0"]) == 143
+    captured = capsys.readouterr()
+    assert captured.err.splitlines() == ["error: terminated; nothing was written"] and captured.out == ""
+    assert not (recording / "tdm").exists() and not list(recording.glob(".tdm.partial-*"))
