@@ -18,7 +18,8 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from tdm.errors import RecordingError
-from tdm.evaluate import read_reports, read_truth_enu
+from tdm.eval_lines import read_reports
+from tdm.eval_truth import read_truth_samples, truth_enu_and_span, truth_span
 
 #: Figure resolution, dots per inch.
 DPI = 100
@@ -26,6 +27,11 @@ DPI = 100
 ID_COLORMAP = "tab20"
 #: A gap longer than this many epoch steps breaks an error curve.
 GAP_EPOCHS = 1.5
+#: Truth tracks are drawn through the samples at (or around) every this many seconds, and each object's first
+#: and last, s: the picture's memory does not grow with the 10 Hz truth.
+TRUTH_STEP_S = 1.0
+#: Most times the truth tracks are drawn at (the step grows beyond it for very long recordings).
+MAX_TRUTH_TIMES = 20_000
 
 
 def _save(fig: Figure, out_png: Path) -> Path:
@@ -74,6 +80,16 @@ def recording_title(recording: Path) -> str:
     return "recording"
 
 
+def _truth_for_plot(recording: Path) -> tuple:
+    """(frame, truth columns) of the samples at about every :data:`TRUTH_STEP_S` s (:func:`tdm.eval_truth.read_truth_enu`)."""
+    path = Path(recording) / "truth.jsonl"
+    t0_s, t1_s = truth_span(path) or read_truth_samples(path, np.zeros(0))[1]
+    step_s = max(TRUTH_STEP_S, (t1_s - t0_s) / MAX_TRUTH_TIMES)
+    times_s = np.floor(t0_s) + step_s * np.arange(int((t1_s - np.floor(t0_s)) // step_s) + 1)
+    frame, truth, _ = truth_enu_and_span(recording, times_s)
+    return frame, truth
+
+
 def plot_tracks(recording: Path, out_png: Path | None = None) -> Path:
     """Targets' tracks coloured by target id over the truth tracks and the own ship's path.
 
@@ -93,7 +109,7 @@ def plot_tracks(recording: Path, out_png: Path | None = None) -> Path:
     targets_path = recording / "tdm" / "detected_targets.jsonl"
     if not targets_path.is_file():
         raise RecordingError(str(targets_path), "(file)", "missing: run `tdm run` first")
-    frame, truth = read_truth_enu(recording)
+    frame, truth = _truth_for_plot(recording)
     targets = read_reports(targets_path, frame)
 
     fig = _figure(8, 8)

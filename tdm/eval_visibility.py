@@ -1,0 +1,262 @@
+"""Which truth objects each sensor could see at each epoch: ranges, and the sweeps' ray truth.
+
+The LiDAR sweeps' ``object_id`` (which object each point hit) and the radar sweeps'
+``object_id`` / ``object_spokes`` (which objects each revolution's rays reached) are read one
+sweep at a time; only what the (E, K) masks need is kept.
+
+Sweep files (docs/formats.md, "What tdm evaluate refuses"):
+
+- a file cut short (zero bytes, or a zip archive without its end: the renderer stopped while
+  writing it) is a *warning*, counted in the returned warnings: that sweep saw nothing;
+- anything else that does not read as the format says (not an NPZ, an array of the wrong
+  dtype or shape, lengths that disagree, non-finite times or angles, an array header that
+  declares more data than its file holds) is an *error* (:class:`tdm.errors.RecordingError`);
+- sweeps without the ray-truth arrays (made before they existed) make the sensor's
+  visibility its range, as before.
+"""
+
+from __future__ import annotations
+
+import zipfile
+import zlib
+from array import array
+from pathlib import Path
+
+import numpy as np
+
+from tdm.errors import RecordingError
+from tdm.eval_params import EvalParams
+from tdm.eval_truth import TruthAtEpochs
+
+#: Half-width of the window about an epoch in which a LiDAR hit, or the radar's view of an object, makes it
+#: visible, s (task definition).
+VISIBLE_WINDOW_S = 0.5
+#: Fewest spokes of a revolution whose rays must reach an object for the radar to see it (0.5 deg at 2048
+#: spokes; a radar plot needs 3 spokes too, docs/tdm.md).
+RADAR_VISIBLE_MIN_SPOKES = 3
+#: First bytes of a zip archive (an NPZ file).
+ZIP_MAGIC = b"PK\x03\x04"
+#: Arrays read from a LiDAR sweep: name -> (accepted dtype kinds, ndim).
+LIDAR_ARRAYS = {"object_id": ("iu", 1), "time": ("f", 1)}
+#: Arrays read from a radar sweep: name -> (accepted dtype kinds, ndim).
+RADAR_ARRAYS = {"object_id": ("iu", 1), "object_spokes": ("iu", 1), "time": ("f", 1), "azimuth_deg": ("f", 1),
+                "heading_deg": ("f", 1)}
+#: Returned by :func:`load_sweep` for a sweep without the ray-truth arrays.
+NO_RAY_TRUTH = "no ray truth"
+#: Exceptions of reading a zip archive or an NPY array that mean the file is not what its name says.
+_UNREADABLE = (zipfile.BadZipFile, zlib.error, OSError, ValueError, EOFError, NotImplementedError, KeyError)
+
+
+def _count(warnings: dict[str, int], what: str) -> None:
+    warnings[what] = warnings.get(what, 0) + 1
+
+
+def _cut_short(file: Path) -> bool:
+    """Zero bytes, or a zip archive's start without its end (the central directory is written last)."""
+    if file.stat().st_size == 0:
+        return True
+    with open(file, "rb") as handle:
+        magic = handle.read(len(ZIP_MAGIC))
+    return magic == ZIP_MAGIC and not zipfile.is_zipfile(file)
+
+
+def _read_member(archive: zipfile.ZipFile, file: Path, name: str, kinds: str, ndim: int) -> np.ndarray:
+    """One array of an NPZ, its header checked (dtype kind, ndim, size against the member's) before reading."""
+    info = archive.getinfo(f"{name}.npy")
+    with archive.open(info) as handle:
+        version = np.lib.format.read_magic(handle)
+        if version == (1, 0):
+            shape, _, dtype = np.lib.format.read_array_header_1_0(handle)
+        elif version == (2, 0):
+            shape, _, dtype = np.lib.format.read_array_header_2_0(handle)
+        else:
+            raise RecordingError(str(file), name, f"NPY format version {version} not supported")
+    if dtype.hasobject or dtype.kind not in kinds or len(shape) != ndim:
+        raise RecordingError(str(file), name, f"array of dtype {dtype} and shape {shape}: expected {ndim}-D of kind "
+                                              f"{' or '.join(repr(k) for k in kinds)} (docs/formats.md)")
+    if int(np.prod(shape, dtype=np.float64)) * dtype.itemsize > info.file_size:
+        raise RecordingError(str(file), name, f"header declares shape {shape}, more than the file holds")
+    with archive.open(info) as handle:
+        return np.lib.format.read_array(handle, allow_pickle=False)
+
+
+def load_sweep(file: Path, spec: dict[str, tuple[str, int]], sensor: str, warnings: dict[str, int]):
+    """The arrays ``spec`` of one sweep file, checked.
+
+    Returns
+    -------
+    dict of arrays, None or :data:`NO_RAY_TRUTH`
+        The arrays; None for a file cut short (counted in ``warnings``); NO_RAY_TRUTH when the
+        file lacks one of the arrays.
+
+    Raises
+    ------
+    RecordingError
+        Not an NPZ, or an array not as ``spec`` says (module docstring).
+    """
+    try:
+        if _cut_short(file):
+            _count(warnings, f"{sensor}/sweeps: files cut short (no end of archive), counted as not seen")
+            return None
+        with zipfile.ZipFile(file) as archive:
+            names = set(archive.namelist())
+            if not all(f"{name}.npy" in names for name in spec):
+                return NO_RAY_TRUTH
+            return {name: _read_member(archive, file, name, kinds, ndim) for name, (kinds, ndim) in spec.items()}
+    except _UNREADABLE as exc:
+        raise RecordingError(str(file), "(file)", f"not a readable NPZ ({type(exc).__name__})") from None
+
+
+def _same_length(file: Path, arrays: dict[str, np.ndarray], names: tuple[str, ...]) -> None:
+    sizes = {name: arrays[name].size for name in names}
+    if len(set(sizes.values())) > 1:
+        raise RecordingError(str(file), ", ".join(names), f"lengths differ: {sizes}")
+
+
+def _finite(file: Path, arrays: dict[str, np.ndarray], names: tuple[str, ...]) -> None:
+    for name in names:
+        if not np.all(np.isfinite(arrays[name])):
+            raise RecordingError(str(file), name, "holds NaN or infinite values")
+
+
+def _sweep_files(recording: Path, sensor: str) -> list[Path]:
+    return sorted((Path(recording) / sensor / "sweeps").glob("*.npz"))
+
+
+def lidar_visible(recording: Path, truth: TruthAtEpochs, warnings: dict[str, int]) -> np.ndarray | None:
+    """(E, K) bool: a LiDAR point hit the object within +-:data:`VISIBLE_WINDOW_S` of the epoch; None without ray truth.
+
+    Each sweep is reduced to the first and last hit time per object (the window is longer than a
+    revolution, so a window that meets a sweep's hits on an object contains one of the two), and
+    each of those times marks the epochs t with ``t - w <= hit <= t + w`` (difference array,
+    cumulated at the end).
+    """
+    files = _sweep_files(recording, "lidar")
+    if not files:
+        return None
+    column = {int(object_id): k for k, object_id in enumerate(truth.ids)}
+    lo_s, hi_s = truth.t_s - VISIBLE_WINDOW_S, truth.t_s + VISIBLE_WINDOW_S
+    marks = np.zeros((truth.t_s.size + 1, truth.ids.size), dtype=np.int64)
+    for file in files:  # loop over sweeps, vectorised within
+        sweep = load_sweep(file, LIDAR_ARRAYS, "lidar", warnings)
+        if sweep is NO_RAY_TRUTH:
+            return None
+        if sweep is None:
+            continue
+        _same_length(file, sweep, ("object_id", "time"))
+        oid, t = sweep["object_id"], sweep["time"]
+        hit = oid >= 0
+        if not hit.any():
+            continue
+        o, t = oid[hit].astype(np.int64), t[hit].astype(float)
+        _finite(file, {"time": t}, ("time",))
+        order = np.lexsort((t, o))
+        o, t = o[order], t[order]
+        starts = np.flatnonzero(np.r_[True, o[1:] != o[:-1]])
+        ends = np.r_[starts[1:], o.size] - 1
+        ids, times = np.r_[o[starts], o[ends]], np.r_[t[starts], t[ends]]
+        known = np.array([int(i) in column for i in ids], dtype=bool)  # a few objects a sweep
+        k = np.array([column[int(i)] for i in ids[known]], dtype=np.int64)
+        first_e = np.searchsorted(hi_s, times[known], side="left")  # first epoch with t + w >= hit
+        stop_e = np.searchsorted(lo_s, times[known], side="right")  # epochs with t - w <= hit end here
+        np.add.at(marks, (first_e, k), 1)
+        np.add.at(marks, (stop_e, k), -1)
+    return np.cumsum(marks, axis=0)[:-1] > 0
+
+
+def _radar_passes(sweep: dict[str, np.ndarray], truth: TruthAtEpochs, column: dict[int, int]):
+    """(objects reached on enough spokes, their beam-pass times s, the revolution's period s) of one sweep."""
+    ids, spokes, t = sweep["object_id"], sweep["object_spokes"], sweep["time"]
+    period_s = float(t[-1] - t[0]) * t.size / max(t.size - 1, 1)
+    reached = [int(i) for i in ids[spokes >= RADAR_VISIBLE_MIN_SPOKES] if int(i) in column]
+    if not reached:
+        return reached, np.zeros(0), period_s
+    k = np.array([column[i] for i in reached])
+    t_mid = 0.5 * float(t[0] + t[-1])
+    east = np.array([np.interp(t_mid, truth.t_s, truth.east_m[:, j]) for j in k])  # a few objects
+    north = np.array([np.interp(t_mid, truth.t_s, truth.north_m[:, j]) for j in k])
+    bearing_deg = np.degrees(np.arctan2(east - np.interp(t_mid, truth.t_s, truth.own_east_m),
+                                        north - np.interp(t_mid, truth.t_s, truth.own_north_m)))
+    compass_deg = sweep["azimuth_deg"].astype(np.float64) + sweep["heading_deg"].astype(np.float64)
+    off = np.abs((compass_deg[None, :] - bearing_deg[:, None] + 180.0) % 360.0 - 180.0)
+    t_pass = np.where(np.isfinite(bearing_deg), t[np.argmin(off, axis=1)], t[0])
+    return reached, t_pass, period_s
+
+
+def radar_seen_intervals(recording: Path, truth: TruthAtEpochs,
+                         warnings: dict[str, int]) -> dict[int, tuple[np.ndarray, np.ndarray]] | None:
+    """When the radar saw each truth object: {id: ((R,) start s, (R,) end s)}, one interval per revolution.
+
+    An object counts as seen in a revolution when its rays reached it on at least
+    :data:`RADAR_VISIBLE_MIN_SPOKES` spokes (the sweep's ``object_id`` / ``object_spokes``). It is
+    seen from the beam's pass over it (the time of the spoke whose compass bearing, azimuth +
+    heading, is nearest the object's bearing from the own ship at the middle of the revolution) until
+    one revolution later, when the next pass looks again. None when the sweeps carry no ``object_id``.
+    """
+    files = _sweep_files(recording, "radar")
+    if not files:
+        return None
+    column = {int(object_id): k for k, object_id in enumerate(truth.ids)}
+    seen: dict[int, array] = {}  # id -> start, end, start, end, ... s
+    for file in files:  # loop over sweeps, a few ids each
+        sweep = load_sweep(file, RADAR_ARRAYS, "radar", warnings)
+        if sweep is NO_RAY_TRUTH:
+            return None
+        if sweep is None:
+            continue
+        _same_length(file, sweep, ("object_id", "object_spokes"))
+        _same_length(file, sweep, ("time", "azimuth_deg", "heading_deg"))
+        _finite(file, sweep, ("time", "azimuth_deg", "heading_deg"))
+        if sweep["time"].size == 0:
+            continue
+        reached, t_pass, period_s = _radar_passes(sweep, truth, column)
+        for object_id, start in zip(reached, t_pass):
+            seen.setdefault(object_id, array("d")).extend((float(start), float(start) + period_s))
+    return {k: (np.array(v[0::2]), np.array(v[1::2])) for k, v in seen.items()}
+
+
+def _overlaps(starts: np.ndarray, ends: np.ndarray, t_s: np.ndarray, half_window_s: float) -> np.ndarray:
+    """(E,) bool: some interval [start, end] meets [t - w, t + w] (starts ascending, ends ascending)."""
+    if starts.size == 0:
+        return np.zeros(t_s.shape, dtype=bool)
+    idx = np.searchsorted(ends, t_s - half_window_s, side="left")
+    return (idx < ends.size) & (starts[np.minimum(idx, ends.size - 1)] <= t_s + half_window_s)
+
+
+def visibility(recording: Path, params: EvalParams, truth: TruthAtEpochs,
+               warnings: dict[str, int]) -> tuple[dict, dict, dict]:
+    """Per rendered sensor, the (E, K) in-range mask; per sensor whose view is ray truth, the (E, K) mask of
+    objects within its range but hidden from it (occluded, below the horizon); and the parameters used.
+
+    ``warnings`` receives a count per kind of sweep file cut short (module docstring).
+    """
+    present = np.isfinite(truth.range_m)
+    rng = np.where(present, truth.range_m, np.inf)
+    visible, hidden = {}, {}
+    lidar_mode = radar_mode = None
+    if "radar" in params.rendered:
+        visible["radar"] = rng <= params.radar_range_m
+        seen = radar_seen_intervals(recording, truth, warnings)
+        radar_mode = "range" if seen is None else "rays"
+        if seen is not None:
+            mask = np.zeros(rng.shape, dtype=bool)
+            for k, object_id in enumerate(truth.ids):  # loop over objects
+                if int(object_id) in seen:
+                    mask[:, k] = _overlaps(*seen[int(object_id)], truth.t_s, VISIBLE_WINDOW_S)
+            hidden["radar"] = visible["radar"] & present & ~mask
+            visible["radar"] &= mask
+    if "ais" in params.rendered:
+        visible["ais"] = truth.ais & (rng <= params.ais_range_m)
+    if "lidar" in params.rendered:
+        mask = lidar_visible(recording, truth, warnings)
+        if mask is None:
+            lidar_mode = "range"
+            visible["lidar"] = rng <= params.lidar_range_m
+        else:
+            lidar_mode = "hits"
+            visible["lidar"] = mask & present
+            hidden["lidar"] = (rng <= params.lidar_range_m) & present & ~mask
+    used = {"sensors_rendered": list(params.rendered), "radar_range_m": params.radar_range_m,
+            "ais_range_m": params.ais_range_m, "lidar_range_max_m": params.lidar_range_m,
+            "lidar_visibility": lidar_mode, "radar_visibility": radar_mode}
+    return visible, hidden, used
