@@ -103,8 +103,9 @@ def make_recording(root, sensors=("radar", "ais", "nav"), targets=True, tracks=T
                             "radar": {"enabled": True, "range_m": 1000.0},
                             "ais": {"enabled": True, "range_m": 10000.0}}}
     (root / "scenario.yaml").write_text(yaml.safe_dump(scenario), encoding="utf-8")
-    (root / "manifest.json").write_text(json.dumps({"duration_s": DURATION_S, "sensors_rendered": list(sensors)}),
-                                        encoding="utf-8")
+    manifest = {"format": "raysim-recording", "format_version": 1, "scenario": "synthetic", "seed": 1,
+                "start_time": "2017-06-01T12:00:00Z", "duration_s": DURATION_S, "sensors_rendered": list(sensors)}
+    (root / "manifest.json").write_text(json.dumps(manifest), encoding="utf-8")
     (root / "tdm").mkdir()
     if targets:
         lines = (_target_lines if targets is True else targets)(frame)
