@@ -9,3 +9,6 @@ class RecordingError(Exception):
     def __init__(self, file: str, where: str, what: str):
         self.file, self.where, self.what = str(file), str(where), " ".join(str(what).split())
         super().__init__(f"{self.file}: {self.where}: {self.what}")
+
+    def __reduce__(self):  # raised in a worker process, re-raised in the parent
+        return (type(self), (self.file, self.where, self.what))

@@ -52,8 +52,11 @@ import numpy as np
 
 from tdm.detections import ReadStats
 from tdm.errors import RecordingError
+from tdm.recording.files import regular_file
+from tdm.recording.pcap_times import PacketClock
 
-__all__ = ["iter_pcap_sweeps", "decode_packets", "firing_azimuths_centideg", "ELEVATION_DEG", "Z_OFFSET_M", "RING"]
+__all__ = ["iter_pcap_sweeps", "check_pcap_header", "decode_packets", "firing_azimuths_centideg", "ELEVATION_DEG",
+           "Z_OFFSET_M", "RING"]
 
 # ----------------------------------------------------------------------------- HDL-32E facts
 # docs/reference.md section 2 (HDL-32E manual 63-9113; ros-drivers/velodyne 32db.yaml;
@@ -148,6 +151,13 @@ def _read_global_header(path: Path, head: bytes) -> _Format:
         raise RecordingError(str(path), "byte 20", f"link type {link_type} not supported (expected 1 Ethernet, "
                                                    "113 Linux cooked or 101/228 raw IPv4)")
     return _Format(order, frac_ns, link_type)
+
+
+def check_pcap_header(path: Path) -> None:
+    """RecordingError unless ``path`` is a readable classic PCAP of a supported link type (its 24-byte header)."""
+    regular_file(path)
+    with open(path, "rb") as handle:
+        _read_global_header(Path(path), handle.read(GLOBAL_HEADER_BYTES))
 
 
 # ----------------------------------------------------------------------------- record walking
@@ -248,7 +258,9 @@ def _walk_records(buf: np.ndarray, fmt: _Format, stats: ReadStats, final: bool,
             mismatch = np.flatnonzero(lengths != length)
             count = 1 + (int(mismatch[0]) if mismatch.size else k_max - 1)
         runs.append((pos, count, length))
-        state["last_sec"] = int(_u32(buf, np.array([pos + size * (count - 1)], dtype=np.int64), fmt.order)[0])
+        last_sec = int(_u32(buf, np.array([pos + size * (count - 1)], dtype=np.int64), fmt.order)[0])
+        if last_sec > 0:  # a record time of 0 (a clock never set) must not make every later record look damaged
+            state["last_sec"] = last_sec
         pos += count * size
         probe = min(probe * 4, 1 << 16) if count == k_max else 16
     if final and pos < end:
@@ -366,7 +378,7 @@ def firing_azimuths_centideg(block_az: np.ndarray, dual: np.ndarray) -> np.ndarr
 
 
 def decode_packets(payloads: np.ndarray, capture_ns: np.ndarray, start_ns: int,
-                   stats: ReadStats) -> dict[str, np.ndarray] | None:
+                   stats: ReadStats, clock: PacketClock | None = None) -> dict[str, np.ndarray] | None:
     """Points and firing cycles of consecutive HDL-32E data packets.
 
     Parameters
@@ -378,6 +390,9 @@ def decode_packets(payloads: np.ndarray, capture_ns: np.ndarray, start_ns: int,
     start_ns : int
         UNIX time of the recording's start, ns.
     stats : ReadStats
+    clock : PacketClock, optional
+        Skips (and counts) packets whose time is outside the run or going back
+        (:mod:`tdm.recording.pcap_times`).
 
     Returns
     -------
@@ -423,6 +438,13 @@ def decode_packets(payloads: np.ndarray, capture_ns: np.ndarray, start_ns: int,
         cycles = np.where(dual, BLOCKS_PER_PACKET // 2, BLOCKS_PER_PACKET)
         first_ns = np.where(unsynced, capture_ns - cycles * CYCLE_DT_NS, first_ns)
     rel_ns = first_ns - int(start_ns)
+    if clock is not None:
+        timely = clock.keep(rel_ns, stats)
+        if not timely.all():
+            blocks, dual, rel_ns = blocks[timely], dual[timely], rel_ns[timely]
+            p = blocks.shape[0]
+            if p == 0:
+                return None
 
     # firing cycles: one per block (single return) or per pair of blocks (dual)
     block_az = blocks["azimuth"]
@@ -472,7 +494,8 @@ def _concat(pieces: list[dict[str, np.ndarray]]) -> dict[str, np.ndarray]:
 
 
 def iter_pcap_sweeps(path: Path, start_time_unix_s: float, stats: ReadStats,
-                     chunk_bytes: int = DEFAULT_CHUNK_BYTES) -> Iterator[dict[str, np.ndarray]]:
+                     chunk_bytes: int = DEFAULT_CHUNK_BYTES,
+                     window_s: tuple[float, float] | None = None) -> Iterator[dict[str, np.ndarray]]:
     """Revolutions of an HDL-32E PCAP file, in time order.
 
     Parameters
@@ -490,6 +513,9 @@ def iter_pcap_sweeps(path: Path, start_time_unix_s: float, stats: ReadStats,
     chunk_bytes : int
         Bytes read at a time. Peak memory is about 25 times this (about 100 MB at the default,
         measured on a 60 s recording), whatever the file's length.
+    window_s : (float, float), optional
+        Times a packet of this run may have, s since the start: packets outside it or going back
+        in time are counted and skipped (:class:`~tdm.recording.pcap_times.PacketClock`).
 
     Yields
     ------
@@ -504,18 +530,16 @@ def iter_pcap_sweeps(path: Path, start_time_unix_s: float, stats: ReadStats,
     Raises
     ------
     RecordingError
-        The file is missing, is not a classic PCAP (bad magic, short header), or has an
-        unsupported link type.
+        The file is missing or not a readable regular file, is not a classic PCAP (bad magic,
+        short header), or has an unsupported link type.
     """
     path = Path(path)
     start_ns = int(round(float(start_time_unix_s) * 1e6)) * 1000
-    try:
-        handle = open(path, "rb")
-    except FileNotFoundError:
-        raise RecordingError(str(path), "(file)", "missing") from None
-    with handle:
+    regular_file(path)
+    with open(path, "rb") as handle:
         fmt = _read_global_header(path, handle.read(GLOBAL_HEADER_BYTES))
         carry = np.zeros(0, dtype=np.uint8)
+        clock = PacketClock(window_s) if window_s is not None else None
         state: dict = {}
         pending: list[dict[str, np.ndarray]] = []  # pieces of the revolution in progress
         last_az: int | None = None  # azimuth of the last firing cycle seen
@@ -539,7 +563,7 @@ def iter_pcap_sweeps(path: Path, start_time_unix_s: float, stats: ReadStats,
                     payloads.append(pl)
             if not payloads:
                 continue
-            decoded = decode_packets(np.concatenate(payloads), np.concatenate(captures), start_ns, stats)
+            decoded = decode_packets(np.concatenate(payloads), np.concatenate(captures), start_ns, stats, clock)
             if decoded is None:
                 continue
             step = decoded["cycle_step_centideg"]

@@ -1,0 +1,248 @@
+"""NumPy ``.npz`` archives read without trusting them: headers first, then bounded loads.
+
+``np.load`` allocates what an array's header claims before it reads a byte, and fails with
+``BadZipFile``, ``EOFError``, ``ValueError`` or ``zlib.error`` on a cut or damaged file. Here:
+
+* :func:`read_layout` opens the zip directory and reads each ``<name>.npy`` member's header only:
+  dtype, shape, order. A header whose size (shape x item size) is not the size the zip directory
+  gives for the member, or beyond :data:`MAX_ARRAY_BYTES`, is refused before anything is allocated.
+* :func:`load_arrays` then reads the asked members into arrays of exactly that checked size.
+
+A file that cannot be read as such an archive at all (zero bytes, not a zip, cut short, damaged
+member data or header) raises :class:`Unreadable` with a short reason: what copying or a crash
+leaves, which callers count as a warning. A path that is not a readable regular file raises
+:class:`tdm.errors.RecordingError` (:func:`tdm.recording.files.regular_file`). Object (pickled)
+arrays raise :class:`tdm.errors.RecordingError`: a sweep holds numbers only.
+"""
+
+from __future__ import annotations
+
+import functools
+import io
+import math
+import os
+import zipfile
+import zlib
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from tdm.errors import RecordingError
+from tdm.recording.files import regular_file
+
+__all__ = ["ArrayHeader", "NpzFile", "Unreadable", "read_layout", "load_arrays", "MAX_ARRAY_BYTES"]
+
+#: Largest array accepted in a sweep file, bytes (a radar sweep's echo is 2 MiB, a LiDAR sweep's x 0.3 MiB).
+MAX_ARRAY_BYTES = 1 << 30
+#: Longest ``.npy`` header text accepted, bytes (numpy writes 128 and refuses to read over 10,000).
+MAX_HEADER_BYTES = 1 << 16
+_ZIP_ERRORS = (zipfile.BadZipFile, zlib.error, EOFError, OSError, ValueError, NotImplementedError, RuntimeError,
+               KeyError)
+
+
+class Unreadable(Exception):
+    """A file that cannot be read as an archive of ``.npy`` arrays.
+
+    Attributes
+    ----------
+    reason : str
+        How, one fixed phrase (:data:`ZERO_BYTES`, :data:`NOT_A_ZIP`, :data:`CUT_SHORT`, :data:`DAMAGED`): the
+        warning keys of the callers are built from it.
+    detail : str
+        Which array and what was found, for a reader of the message.
+    """
+
+    def __init__(self, reason: str, detail: str = ""):
+        self.reason, self.detail = reason, detail
+        super().__init__(f"{reason}: {detail}" if detail else reason)
+
+    def __reduce__(self):
+        return (type(self), (self.reason, self.detail))
+
+
+ZERO_BYTES = "zero bytes"
+NOT_A_ZIP = "not a zip archive"
+CUT_SHORT = "zip archive cut short"
+DAMAGED = "damaged array data"
+
+
+@dataclass(frozen=True)
+class ArrayHeader:
+    """What a member's ``.npy`` header says.
+
+    Attributes
+    ----------
+    name : str
+        Array name (member name without ``.npy``).
+    dtype : numpy.dtype
+    shape : tuple of int
+    fortran_order : bool
+    """
+
+    name: str
+    dtype: np.dtype
+    shape: tuple[int, ...]
+    fortran_order: bool
+
+    @property
+    def nbytes(self) -> int:
+        return math.prod(self.shape) * self.dtype.itemsize
+
+
+def _open_zip(path: Path) -> zipfile.ZipFile:
+    regular_file(path)
+    size = os.stat(path).st_size
+    if size == 0:
+        raise Unreadable(ZERO_BYTES)
+    with open(path, "rb") as handle:
+        magic = handle.read(2)
+    if magic != b"PK":
+        raise Unreadable(NOT_A_ZIP)
+    try:
+        return zipfile.ZipFile(path)
+    except _ZIP_ERRORS:
+        raise Unreadable(CUT_SHORT) from None
+
+
+@functools.lru_cache(maxsize=512)
+def _decode_header(raw: bytes) -> tuple[tuple[int, ...], bool, np.dtype] | tuple[int, int]:
+    """(shape, fortran order, dtype) of a ``.npy`` header's bytes (magic to the end of the header text),
+    or the format version when it is neither 1.0 nor 2.0. Cached: the arrays of a sweep, and of the
+    sweeps of a run, repeat the same few headers."""
+    fp = io.BytesIO(raw)
+    version = np.lib.format.read_magic(fp)
+    if version == (1, 0):
+        return np.lib.format.read_array_header_1_0(fp)
+    if version == (2, 0):
+        return np.lib.format.read_array_header_2_0(fp)
+    return version
+
+
+def _read_exactly(fp, n: int) -> bytes:
+    data = fp.read(n)
+    if len(data) != n:
+        raise EOFError("member ends inside its .npy header")
+    return data
+
+
+def _parse_header(fp, info: zipfile.ZipInfo, path: Path) -> ArrayHeader:
+    """The header of a member opened at its start (``fp`` is left at the array's data)."""
+    name = info.filename[:-4]
+    prefix = _read_exactly(fp, 10)  # magic (6), version (2), header length (2 in version 1.0, else 4)
+    if prefix[6] != 1:
+        prefix += _read_exactly(fp, 2)
+    length = int.from_bytes(prefix[8:], "little")
+    if length > MAX_HEADER_BYTES:
+        raise Unreadable(DAMAGED, f"array {name!r}: a .npy header of {length} bytes")
+    raw = prefix + _read_exactly(fp, length)
+    decoded = _decode_header(raw)
+    if len(decoded) == 2:
+        raise RecordingError(str(path), name, f".npy format version {decoded} not supported (1.0, 2.0)")
+    shape, fortran, dtype = decoded
+    if dtype.hasobject:
+        raise RecordingError(str(path), name, "holds Python objects (pickled data), not numbers")
+    header = ArrayHeader(name, dtype, tuple(int(n) for n in shape), bool(fortran))
+    data_offset = len(raw)
+    if data_offset + header.nbytes != info.file_size:  # the header and the zip directory disagree
+        raise Unreadable(DAMAGED, f"array {name!r}: its header says {header.nbytes} bytes of data, the archive "
+                                  f"holds {info.file_size - data_offset}")
+    if header.nbytes > MAX_ARRAY_BYTES:  # consistent, but no sweep is that big
+        raise RecordingError(str(path), name, f"shape {header.shape} of {header.nbytes} bytes, more than the "
+                                              f"{MAX_ARRAY_BYTES} an array of a sweep may hold")
+    return header
+
+
+def _member_header(zf: zipfile.ZipFile, info: zipfile.ZipInfo, path: Path) -> ArrayHeader:
+    try:
+        with zf.open(info) as fp:
+            return _parse_header(fp, info, path)
+    except _ZIP_ERRORS:
+        raise Unreadable(DAMAGED, f"array {info.filename[:-4]!r}") from None
+
+
+class NpzFile:
+    """An open ``.npz`` archive: ``layout`` (every array's checked header) and :meth:`load`.
+
+    Use as a context manager. Opening raises as :func:`read_layout`.
+
+    Parameters
+    ----------
+    path : Path
+    preload : tuple of str
+        Arrays to read while the headers are read (one pass over each member); :meth:`load` then
+        hands them out.
+    """
+
+    def __init__(self, path: Path, preload: tuple[str, ...] = ()):
+        self.path = Path(path)
+        self._zf = _open_zip(self.path)
+        self._loaded: dict[str, np.ndarray] = {}
+        try:
+            self._infos = {info.filename[:-4]: info for info in self._zf.infolist() if info.filename.endswith(".npy")}
+            self.layout = {}
+            for name, info in self._infos.items():
+                if name in preload:
+                    self.layout[name], self._loaded[name] = _read_member(self._zf, info, self.path)
+                else:
+                    self.layout[name] = _member_header(self._zf, info, self.path)
+        except BaseException:
+            self._zf.close()
+            raise
+
+    def load(self, names: tuple[str, ...]) -> dict[str, np.ndarray]:
+        """The arrays ``names`` as ``np.load`` would give them (dtype, shape and order of the file)."""
+        missing = [n for n in names if n not in self._infos]
+        if missing:
+            raise RecordingError(str(self.path), missing[0], "array missing")
+        return {n: self._loaded[n] if n in self._loaded else _read_member(self._zf, self._infos[n], self.path)[1]
+                for n in names}
+
+    def close(self) -> None:
+        self._zf.close()
+
+    def __enter__(self) -> "NpzFile":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+def read_layout(path: Path) -> dict[str, ArrayHeader]:
+    """Every array's header of an ``.npz`` file, checked against the zip directory (module docstring).
+
+    Raises
+    ------
+    Unreadable
+        Zero bytes, not a zip, cut short, or a damaged member.
+    RecordingError
+        Not a readable regular file; an object array; an array beyond :data:`MAX_ARRAY_BYTES`.
+    """
+    with NpzFile(path) as npz:
+        return npz.layout
+
+
+def _read_member(zf: zipfile.ZipFile, info: zipfile.ZipInfo, path: Path) -> tuple[ArrayHeader, np.ndarray]:
+    try:
+        with zf.open(info) as fp:
+            header = _parse_header(fp, info, path)
+            flat = np.empty(math.prod(header.shape), dtype=header.dtype)  # size checked against the archive
+            view = memoryview(flat.view(np.uint8)) if header.nbytes else memoryview(bytearray(0))
+            got = 0
+            while got < header.nbytes:
+                n = fp.readinto(view[got:])
+                if not n:
+                    raise Unreadable(DAMAGED, f"array {header.name!r} cut short")
+                got += n
+            fp.read(1)  # reach the member's end: the zip CRC is checked there
+    except _ZIP_ERRORS:
+        raise Unreadable(DAMAGED, f"array {info.filename[:-4]!r}") from None
+    if header.fortran_order:
+        return header, flat.reshape(header.shape[::-1]).transpose()
+    return header, flat.reshape(header.shape)
+
+
+def load_arrays(path: Path, names: tuple[str, ...]) -> dict[str, np.ndarray]:
+    """The arrays ``names`` of an ``.npz`` file (each must be in it; errors as :func:`read_layout`)."""
+    with NpzFile(path) as npz:
+        return npz.load(names)

@@ -1,0 +1,121 @@
+"""``scenario.yaml``: the values the TDM takes from the resolved scenario, each checked.
+
+The file must be UTF-8 YAML holding a mapping. Of its keys only those the TDM uses are checked
+(the table :data:`CHECKED`, key path -> kind and bounds): each is absent, null, or a finite number
+within its bounds (whole for counts), so a rate of NaN, 0 or 1e9 Hz, a mount of ``"high"`` or a
+spoke count of 2048.5 is an error naming its key path, never a division by zero or an allocation
+sized by a wild number. Sections the TDM reads (``tdm``, ``sensors``, ``sensors.<name>``, their
+``mount`` and ``own_ship``) must be mappings when present.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import yaml
+
+from tdm.errors import RecordingError
+from tdm.recording import values
+from tdm.recording.files import decode_utf8, read_bytes
+
+__all__ = ["read_scenario", "check_scenario", "CHECKED", "MAX_UPDATE_RATE_HZ"]
+
+#: Highest accepted TDM output rate, Hz (raysim's scenarios allow 50).
+MAX_UPDATE_RATE_HZ = 100.0
+#: A resolved scenario is a few kB (the world's meshes are separate files).
+MAX_SCENARIO_BYTES = 16 << 20
+_MOUNT = {"x_m": ("number", -1000.0, 1000.0), "y_m": ("number", -1000.0, 1000.0), "z_m": ("number", -1000.0, 1000.0),
+          "roll_deg": ("number", -360.0, 360.0), "pitch_deg": ("number", -360.0, 360.0),
+          "yaw_deg": ("number", -360.0, 360.0)}
+
+#: Key path -> (kind, low, high); "rate" is a number > low, "number" one >= low, "count" a whole number.
+CHECKED: dict[str, tuple[str, float, float]] = {
+    "tdm.update_rate_hz": ("rate", 0.0, MAX_UPDATE_RATE_HZ),
+    "own_ship.length_m": ("rate", 0.0, 10_000.0),
+    "own_ship.beam_m": ("rate", 0.0, 10_000.0),
+    "sensors.lidar.rotation_hz": ("rate", 0.0, 100.0),
+    "sensors.lidar.range_min_m": ("number", 0.0, 10_000.0),
+    "sensors.lidar.range_max_m": ("rate", 0.0, 10_000.0),
+    "sensors.lidar.beam_divergence_mrad": ("number", 0.0, 1000.0),
+    "sensors.radar.rpm": ("rate", 0.0, 600.0),
+    "sensors.radar.range_m": ("rate", 0.0, 1.0e6),
+    "sensors.radar.spokes": ("count", 1, 65_536),
+    "sensors.radar.samples": ("count", 1, 65_536),
+    "sensors.radar.beam_az_deg": ("rate", 0.0, 360.0),
+    "sensors.radar.blanking_m": ("number", 0.0, 1.0e6),
+    "sensors.ais.range_m": ("rate", 0.0, 1.0e7),
+    "sensors.nav.position_noise_m": ("number", 0.0, 1.0e6),
+    "sensors.nav.position_bias_m": ("number", 0.0, 1.0e6),
+    "sensors.nav.heading_noise_deg": ("number", 0.0, 360.0),
+    "sensors.nav.heading_bias_deg": ("number", 0.0, 360.0),
+    **{f"sensors.{s}.mount.{k}": v for s in ("lidar", "radar") for k, v in _MOUNT.items()},
+}
+_SECTIONS = ("tdm", "own_ship", "sensors", *(f"sensors.{s}" for s in ("lidar", "radar", "ais", "nav")),
+             "sensors.lidar.mount", "sensors.radar.mount")
+
+
+def _lookup(data: dict, key_path: str):
+    """The value at a dotted key path, or None when any part is absent or null."""
+    node = data
+    for part in key_path.split("."):
+        if not isinstance(node, dict):
+            return None
+        node = node.get(part)
+    return node
+
+
+def check_scenario(data: object, path: Path) -> dict:
+    """``data`` (a parsed scenario) if the TDM's keys are as the module docstring says; else a RecordingError."""
+    if not isinstance(data, dict):
+        raise RecordingError(str(path), "(top level)", f"must be a mapping, not {values.describe(data)}")
+    for section in _SECTIONS:
+        value = _lookup(data, section)
+        if value is not None:
+            values.mapping(value, path, section)
+    for sensor in ("lidar", "radar", "ais", "nav"):
+        enabled = _lookup(data, f"sensors.{sensor}.enabled")
+        if enabled is not None:
+            values.boolean(enabled, path, f"sensors.{sensor}.enabled")
+    for key_path, (kind, low, high) in CHECKED.items():
+        value = _lookup(data, key_path)
+        if value is None:
+            continue
+        if kind == "count":
+            values.integer(value, path, key_path, int(low), int(high))
+        else:
+            values.number(value, path, key_path, low, high, low_open=kind == "rate")
+    return data
+
+
+def read_scenario(recording: Path) -> dict:
+    """The recording's resolved ``scenario.yaml``, checked (module docstring).
+
+    Parameters
+    ----------
+    recording : Path
+        The recording directory.
+
+    Returns
+    -------
+    dict
+        The parsed scenario, unchanged.
+
+    Raises
+    ------
+    RecordingError
+        Missing or unreadable file, not UTF-8, not YAML, not a mapping, or a value the TDM uses
+        out of its type or bounds.
+    """
+    path = Path(recording) / "scenario.yaml"
+    text = decode_utf8(read_bytes(path, missing="missing: not a recording directory", max_bytes=MAX_SCENARIO_BYTES),
+                       path)
+    if not text.strip():
+        raise RecordingError(str(path), "(file)", "empty: not a scenario")
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        raise RecordingError(str(path), f"line {mark.line + 1}" if mark else "(file)", "not valid YAML") from None
+    except RecursionError:
+        raise RecordingError(str(path), "(file)", "not valid YAML: nested too deeply") from None
+    return check_scenario(data, path)
