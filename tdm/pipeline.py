@@ -6,19 +6,21 @@ front ends (in a pool of worker processes: scans are independent), and fed to on
 sensor in the order they end. At every output epoch ``k / update_rate_hz`` the fuser takes the
 confirmed tracks of all sensors and the detected targets are written.
 
-Problems that leave the rest readable (a missing or unreadable sweep file, a cut PCAP, bad
-NMEA lines) are counted as warnings; a recording with nothing to read is an error.
+Every file is read through :mod:`tdm.recording` (docs/formats.md, "Reading a recording: warnings
+and errors"). Problems a real logger leaves and that leave the rest readable (a missing or
+unreadable sweep file, a cut PCAP, bad NMEA lines, a cut last line of ownship.jsonl) are counted as
+warnings; anything else that breaks the format (a wrong dtype, shape or length, a value out of
+bounds, sweeps out of order) and a recording with nothing to read are errors, raised before any
+output file is renamed into place.
 """
 
 from __future__ import annotations
 
 import heapq
 from collections import deque
-import re
 import shutil
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
-from datetime import datetime
 from pathlib import Path
 from typing import Iterator
 
@@ -32,6 +34,12 @@ from tdm.frontend.lidar import LidarFrontEndConfig, lidar_detections
 from tdm.frontend.radar import RadarFrontEndConfig, radar_detections
 from tdm.fusion import Fuser, FusionConfig
 from tdm.io import read_manifest, read_ownship, read_scenario
+from tdm.recording.files import directory_present, is_present, regular_file
+from tdm.recording.manifest import start_time_unix_s as _start_time_unix_s
+from tdm.recording.npz import Unreadable
+from tdm.recording.scenario import MAX_UPDATE_RATE_HZ
+from tdm.recording.sweep_files import SweepOrder, list_sweeps, sweep_window_s
+from tdm.recording.sweeps import SCHEMAS, read_sweep, unreadable_warning
 from tdm.messages import jsonl_writer, target_record
 from tdm.tracker import AisTracker, AisTrackerConfig, PositionTracker, TrackerConfig
 
@@ -97,35 +105,11 @@ class RunResult:
 
 
 def start_time_unix_s(manifest: dict, recording: Path) -> float:
-    text = manifest.get("start_time")
-    try:
-        return datetime.fromisoformat(str(text).replace("Z", "+00:00")).timestamp()
-    except ValueError:
-        raise RecordingError(str(Path(recording) / "manifest.json"), "start_time", f"not an ISO 8601 time: {text!r}") from None
+    """UNIX time of the recording's start, s (:func:`tdm.recording.manifest.start_time_unix_s`)."""
+    return _start_time_unix_s(manifest, recording)
 
 
 # ---- scan sources ----------------------------------------------------------------------------
-
-_NUMBERED = re.compile(r"^(\d+)\.npz$")
-
-
-def _numbered_files(directory: Path, what: str, stats: ReadStats) -> list[Path]:
-    files = sorted(p for p in directory.glob("*.npz") if _NUMBERED.match(p.name))
-    numbers = [int(_NUMBERED.match(p.name).group(1)) for p in files]
-    if numbers:
-        missing = (numbers[-1] - numbers[0] + 1) - len(numbers)
-        if missing:
-            stats.count(f"{what}: sweep files missing from the numbering", missing)
-    return files
-
-
-def _load_npz(path: Path, fields: tuple[str, ...]) -> dict | str:
-    try:
-        with np.load(path) as data:
-            return {k: data[k] for k in fields}
-    except Exception as exc:  # a cut or corrupt file: counted, skipped
-        return f"{type(exc).__name__}"
-
 
 LIDAR_FIELDS = ("x", "y", "z", "ring", "time")  # what the LiDAR front end reads
 RADAR_FIELDS = ("echo", "azimuth_deg", "heading_deg", "time", "range_m")
@@ -133,25 +117,41 @@ RADAR_FIELDS = ("echo", "azimuth_deg", "heading_deg", "time", "range_m")
 _WORKER: dict = {}
 
 
-def _init_worker(track, lidar_mount, lidar_cfg, radar_mount, radar_cfg) -> None:
-    _WORKER.update(track=track, lidar=(lidar_mount, lidar_cfg), radar=(radar_mount, radar_cfg))
+def _init_worker(track, lidar_mount, lidar_cfg, radar_mount, radar_cfg, limits=None) -> None:
+    _WORKER.update(track=track, lidar=(lidar_mount, lidar_cfg), radar=(radar_mount, radar_cfg),
+                   limits=limits or {})
 
 
-def _frontend(job: tuple[str, object]) -> tuple[str, float, Detections | None, str | None]:
-    """Detections of one scan: (sensor, end time s, detections or None, problem or None)."""
+def _read_sweep_file(sensor: str, path: Path) -> dict | str:
+    """A sweep file's arrays, checked (:func:`tdm.recording.sweeps.read_sweep`), or the reason it is unreadable."""
+    window_s, expected = _WORKER["limits"].get(sensor, ((-np.inf, np.inf), None))
+    try:
+        return read_sweep(path, SCHEMAS[sensor], LIDAR_FIELDS if sensor == "lidar" else RADAR_FIELDS, window_s,
+                          expected)
+    except Unreadable as exc:  # zero bytes, cut short, not a zip: counted, skipped
+        return exc.reason
+
+
+def _frontend(job: tuple[str, object]) -> tuple[str, float, float, Detections | None, str | None, Path | None]:
+    """Detections of one scan: (sensor, start and end time s, detections or None, problem or None, file or None).
+
+    A sweep file that breaks the format raises :class:`tdm.errors.RecordingError` (also from a worker).
+    """
     sensor, source = job
-    if isinstance(source, (str, Path)):
-        sweep = _load_npz(Path(source), LIDAR_FIELDS if sensor == "lidar" else RADAR_FIELDS)
+    path = Path(source) if isinstance(source, (str, Path)) else None
+    if path is not None:
+        sweep = _read_sweep_file(sensor, path)
         if isinstance(sweep, str):
-            return sensor, -1.0, None, f"{sensor}/sweeps: unreadable sweep files ({sweep})"
+            return sensor, -1.0, -1.0, None, unreadable_warning(sensor, sweep), path
     else:
         sweep = source
     times = sweep["time"]
     if times.size == 0:
-        return sensor, -1.0, None, f"{sensor}: empty sweeps"
+        return sensor, -1.0, -1.0, None, f"{sensor}: empty sweeps", path
     mount, cfg = _WORKER[sensor]
     func = lidar_detections if sensor == "lidar" else radar_detections
-    return sensor, float(np.max(times)), func(sweep, _WORKER["track"], mount, cfg), None
+    dets = func(sweep, _WORKER["track"], mount, cfg)
+    return sensor, float(np.min(times)), float(np.max(times)), dets, None, path
 
 
 #: Scans per worker task: enough to hide the inter-process overhead (about a millisecond a task).
@@ -171,22 +171,33 @@ def _scan_jobs(recording: Path, config: TdmConfig, manifest: dict, scenario: dic
     lidar_dir, pcap = rec / "lidar" / "sweeps", rec / "lidar" / "hdl32e.pcap"
     lidar_period_s = 1.0 / float((sensors.get("lidar") or {}).get("rotation_hz", 10.0))
     source = config.lidar_source
+    has_npz = directory_present(lidar_dir)  # a file where the directory belongs is an error
     if source == "auto":
-        source = "npz" if lidar_dir.is_dir() else "pcap"
-    if source == "npz" and lidar_dir.is_dir():
-        jobs["lidar"] = ((("lidar", p) for p in _numbered_files(lidar_dir, "lidar", stats)), lidar_period_s)
-    elif source == "pcap" and pcap.is_file():
-        from tdm.pcap import iter_pcap_sweeps
+        source = "npz" if has_npz else "pcap"
+    if source == "npz" and has_npz:
+        jobs["lidar"] = ((("lidar", p) for p in list_sweeps(lidar_dir, "lidar", stats)), lidar_period_s)
+    elif source == "pcap" and is_present(pcap):
+        from tdm.pcap import check_pcap_header, iter_pcap_sweeps
 
-        sweeps = iter_pcap_sweeps(pcap, start_time_unix_s(manifest, rec), stats)
+        check_pcap_header(pcap)
+        sweeps = iter_pcap_sweeps(pcap, start_time_unix_s(manifest, rec), stats,
+                                  window_s=sweep_window_s(float(manifest["duration_s"])))
         jobs["lidar"] = ((("lidar", s) for s in sweeps), lidar_period_s)
     elif config.lidar_source != "auto":
         raise RecordingError(str(pcap if source == "pcap" else lidar_dir), "(file)", f"missing: --lidar-source {source}")
     radar_dir = rec / "radar" / "sweeps"
-    if radar_dir.is_dir():
+    if directory_present(radar_dir):
         radar_period_s = 60.0 / float((sensors.get("radar") or {}).get("rpm", 24.0))
-        jobs["radar"] = ((("radar", p) for p in _numbered_files(radar_dir, "radar", stats)), radar_period_s)
+        jobs["radar"] = ((("radar", p) for p in list_sweeps(radar_dir, "radar", stats)), radar_period_s)
     return jobs
+
+
+def _sweep_limits(manifest: dict, scenario: dict) -> dict[str, tuple[tuple[float, float], dict[str, int] | None]]:
+    """Per sensor: the times its sweeps may hold (s) and the axis lengths scenario.yaml states (radar)."""
+    window_s = sweep_window_s(float(manifest["duration_s"]))
+    radar = (scenario.get("sensors") or {}).get("radar") or {}
+    expected = {axis: int(radar[axis]) for axis in ("spokes", "samples") if radar.get(axis) is not None}
+    return {"lidar": (window_s, None), "radar": (window_s, expected or None)}
 
 
 def _interleaved(jobs: dict[str, tuple[Iterator, float]]) -> Iterator[tuple[str, object]]:
@@ -237,11 +248,14 @@ def _scans(jobs: dict[str, tuple[Iterator, float]], workers: int, initargs,
             yield from pending.popleft().result()
 
     last = -np.inf
+    order = SweepOrder()
     try:
-        for sensor, t_end, dets, problem in results():
+        for sensor, t_start, t_end, dets, problem, path in results():
             if problem:
                 stats.count(problem)
                 continue
+            if path is not None:  # sweep files renamed out of order or duplicated (a PCAP's are in order)
+                order.check(sensor, path, t_start, t_end)
             heapq.heappush(buffer, (t_end, seq, sensor, dets))
             seq += 1
             while buffer and buffer[0][0] < t_end - lag_s:
@@ -285,20 +299,24 @@ class DetectionStream:
         manifest = manifest if manifest is not None else read_manifest(rec)
         scenario = scenario if scenario is not None else read_scenario(rec)
         self.config, self.stats = config, stats
-        self.nav = read_ownship(rec)
+        self.nav = read_ownship(rec, stats)
         self.ownship = OwnshipTrack(self.nav)
         sensors_cfg = scenario.get("sensors") or {}
         lidar_cfg = LidarFrontEndConfig.from_scenario(scenario)
         radar_cfg = RadarFrontEndConfig.from_scenario(scenario)
         lidar_mount = Mount.from_dict((sensors_cfg.get("lidar") or {}).get("mount"))
         radar_mount = Mount.from_dict((sensors_cfg.get("radar") or {}).get("mount"))
-        self._initargs = (self.ownship, lidar_mount, lidar_cfg, radar_mount, radar_cfg)
+        self._initargs = (self.ownship, lidar_mount, lidar_cfg, radar_mount, radar_cfg,
+                          _sweep_limits(manifest, scenario))
         self._jobs = _scan_jobs(rec, config, manifest, scenario, stats)
         ais_path = rec / "ais" / "ais.nmea"
         self.reports, self.static = [], {}
-        if ais_path.is_file():
-            self.reports, self.static = read_ais(ais_path, self.ownship.frame, start_time_unix_s(manifest, rec), stats)
-        if not self._jobs and not ais_path.is_file():
+        has_ais = is_present(ais_path)
+        if has_ais:
+            regular_file(ais_path)  # a directory, a link loop, no permission: an error
+            reports, self.static = read_ais(ais_path, self.ownship.frame, start_time_unix_s(manifest, rec), stats)
+            self.reports = _reports_in_run(reports, float(manifest["duration_s"]), stats)
+        if not self._jobs and not has_ais:
             raise RecordingError(str(rec), "(directory)", "holds no LiDAR, radar or AIS data to detect targets in")
 
     def events(self) -> Iterator[tuple[float, str, object]]:
@@ -307,7 +325,32 @@ class DetectionStream:
                            ((r.time_s, "ais", r) for r in self.reports), key=lambda item: item[0])
 
 
+def _reports_in_run(reports: list, duration_s: float, stats: ReadStats) -> list:
+    """The AIS reports whose times lie within the run (+- the sweeps' margin); the others counted and dropped.
+
+    A receiver clock that jumps (or a TAG block edited by hand) gives times that belong to no epoch.
+    """
+    low, high = sweep_window_s(duration_s)
+    kept = [r for r in reports if low <= r.time_s <= high]
+    if len(kept) < len(reports):
+        stats.count("ais/nmea: message with a time outside the run skipped", len(reports) - len(kept))
+    return kept
+
+
 # ---- the run ---------------------------------------------------------------------------------
+
+
+class _EpochTimes:
+    """The output epochs ``k / rate_hz``, k = 1..n, s, made on demand: no array sized by the recording's numbers."""
+
+    def __init__(self, n: int, rate_hz: float):
+        self.n, self.rate_hz = int(n), float(rate_hz)
+
+    def __len__(self) -> int:
+        return self.n
+
+    def __getitem__(self, k: int) -> float:
+        return (k + 1) / self.rate_hz  # as np.arange(1, n + 1) / rate_hz, element by element
 
 def run_tdm(recording: Path, out_dir: Path | None = None, config: TdmConfig | None = None,
             progress: bool = False) -> RunResult:
@@ -328,8 +371,9 @@ def run_tdm(recording: Path, out_dir: Path | None = None, config: TdmConfig | No
     manifest = read_manifest(rec)
     scenario = read_scenario(rec)
     config = config if config is not None else TdmConfig.for_recording(rec)
-    if config.update_rate_hz <= 0:
-        raise RecordingError(str(rec / "scenario.yaml"), "tdm.update_rate_hz", "must be > 0")
+    if not 0 < config.update_rate_hz <= MAX_UPDATE_RATE_HZ:  # NaN too
+        raise RecordingError(str(rec / "scenario.yaml"), "tdm.update_rate_hz",
+                             f"{config.update_rate_hz!r} must be > 0 and at most {MAX_UPDATE_RATE_HZ:g} Hz")
     out = Path(out_dir) if out_dir is not None else rec / "tdm"
     stats = ReadStats()
     stream = DetectionStream(rec, config, stats, manifest=manifest, scenario=scenario)
@@ -340,7 +384,7 @@ def run_tdm(recording: Path, out_dir: Path | None = None, config: TdmConfig | No
     radar_tcfg = _with_range(config.radar_tracker, (sensors_cfg.get("radar") or {}).get("range_m"))
 
     duration_s = float(manifest.get("duration_s") or nav["t"][-1])
-    epochs = np.arange(1, int(np.floor(duration_s * config.update_rate_hz + 1e-9)) + 1) / config.update_rate_hz
+    epochs = _EpochTimes(int(np.floor(duration_s * config.update_rate_hz + 1e-9)), config.update_rate_hz)
     trackers = {"lidar": PositionTracker("lidar", lidar_tcfg), "radar": PositionTracker("radar", radar_tcfg)}
     ais = AisTracker(config.ais_tracker)
     ais.set_static(stream.static)
