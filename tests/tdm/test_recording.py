@@ -1,0 +1,111 @@
+"""tdm.recording: the reader layer's parts that the corpus (test_corpus.py) does not reach one by one."""
+
+from __future__ import annotations
+
+import io
+import pickle
+import zipfile
+
+import numpy as np
+import pytest
+
+from tdm.detections import ReadStats
+from tdm.errors import RecordingError
+from tdm.pipeline import _EpochTimes
+from tdm.recording.npz import NpzFile, Unreadable, load_arrays, read_layout
+from tdm.recording.pcap_times import BACK, OUTSIDE, PacketClock
+from tdm.recording.values import integer, number
+
+
+def _npz(path, members: dict[str, bytes]) -> None:
+    with zipfile.ZipFile(path, "w", compression=zipfile.ZIP_DEFLATED) as zf:
+        for name, data in members.items():
+            zf.writestr(name, data)
+
+
+def _npy(array: np.ndarray, version=(1, 0)) -> bytes:
+    buf = io.BytesIO()
+    np.lib.format.write_array(buf, array, version=version)
+    return buf.getvalue()
+
+
+def test_arrays_read_as_np_load_reads_them(tmp_path):
+    arrays = {"a": np.arange(12, dtype=">f8").reshape(3, 4), "b": np.asfortranarray(np.ones((2, 5), np.uint8)),
+              "c": np.zeros(0, np.int32)}
+    np.savez(tmp_path / "plain.npz", **arrays)
+    np.savez_compressed(tmp_path / "packed.npz", **arrays)
+    _npz(tmp_path / "v2.npz", {f"{k}.npy": _npy(v, (2, 0)) for k, v in arrays.items()})
+    for name in ("plain.npz", "packed.npz", "v2.npz"):
+        got = load_arrays(tmp_path / name, ("a", "b", "c"))
+        with np.load(tmp_path / name) as want:
+            for key in arrays:
+                assert got[key].dtype == want[key].dtype and got[key].shape == want[key].shape
+                assert np.array_equal(got[key], want[key]) and got[key].flags.writeable
+                assert got[key].flags.f_contiguous == want[key].flags.f_contiguous
+        assert read_layout(tmp_path / name)["a"].shape == (3, 4)
+
+
+def _npy_claiming(data: np.ndarray, shape_text: str) -> bytes:
+    """A version 1.0 ``.npy`` member holding ``data`` (float32) whose header says shape ``shape_text``."""
+    header = ("{'descr': '<f4', 'fortran_order': False, 'shape': %s, }" % shape_text).ljust(117) + "\n"
+    return b"\x93NUMPY\x01\x00" + len(header).to_bytes(2, "little") + header.encode("latin1") + data.tobytes()
+
+
+def test_a_header_claiming_more_than_its_member_holds_is_refused_before_any_allocation(tmp_path):
+    data = np.zeros(10, np.float32)
+    _npz(tmp_path / "honest.npz", {"x.npy": _npy_claiming(data, "(10,)")})
+    assert load_arrays(tmp_path / "honest.npz", ("x",))["x"].shape == (10,)
+    _npz(tmp_path / "lying.npz", {"x.npy": _npy_claiming(data, "(9999999999999,)")})  # 40 TB
+    with pytest.raises(Unreadable) as info:
+        NpzFile(tmp_path / "lying.npz")
+    assert info.value.reason == "damaged array data" and "9999999999999" not in info.value.reason
+
+
+def test_object_arrays_and_unknown_versions_are_errors(tmp_path):
+    np.savez(tmp_path / "objects.npz", x=np.array([{}, None], dtype=object))
+    with pytest.raises(RecordingError, match="pickled data"):
+        read_layout(tmp_path / "objects.npz")
+    _npz(tmp_path / "v3.npz", {"x.npy": _npy(np.arange(3), (3, 0))})
+    with pytest.raises(RecordingError, match="version"):
+        read_layout(tmp_path / "v3.npz")
+
+
+@pytest.mark.parametrize("content, reason", [(b"", "zero bytes"), (b"\0" * 100, "not a zip archive"),
+                                             (b"PK\x03\x04" + b"\0" * 60, "zip archive cut short")])
+def test_unreadable_files_say_why(tmp_path, content, reason):
+    (tmp_path / "s.npz").write_bytes(content)
+    with pytest.raises(Unreadable) as info:
+        read_layout(tmp_path / "s.npz")
+    assert info.value.reason == reason
+    assert pickle.loads(pickle.dumps(info.value)).reason == reason  # crosses process boundaries
+
+
+def test_recording_errors_cross_process_boundaries():
+    exc = pickle.loads(pickle.dumps(RecordingError("a.npz", "x", "not a finite number")))
+    assert (exc.file, exc.where, exc.what) == ("a.npz", "x", "not a finite number")
+
+
+def test_the_packet_clock_skips_packets_outside_the_run_and_going_back():
+    clock, stats = PacketClock((-60.0, 66.0)), ReadStats()
+    s = 1_000_000_000
+    keep = clock.keep(np.array([0, 1, -100 * s, 2, 1, 3, 10**18]) * np.array([s, s, 1, s, s, s, 1]), stats)
+    assert keep.tolist() == [True, True, False, True, False, True, False]
+    assert stats.warnings == {OUTSIDE: 2, BACK: 1}
+    assert clock.keep(np.array([2 * s, 4 * s]), stats).tolist() == [False, True]  # the state carries over
+
+
+def test_the_output_epochs_are_those_of_the_array_they_replace():
+    for duration_s, rate_hz in ((300.0, 1.0), (20.0, 3.0), (7.3, 0.7), (60.0, 50.0)):
+        n = int(np.floor(duration_s * rate_hz + 1e-9))
+        lazy, eager = _EpochTimes(n, rate_hz), np.arange(1, n + 1) / rate_hz
+        assert len(lazy) == eager.size and all(lazy[k] == eager[k] for k in range(n))  # bit for bit
+
+
+def test_numbers_are_finite_and_bounded():
+    assert number(5, "f", "k", 0.0, 10.0, low_open=True) == 5.0
+    for bad in (float("nan"), float("inf"), True, "5", None, 0.0, 11.0):
+        with pytest.raises(RecordingError):
+            number(bad, "f", "k", 0.0, 10.0, low_open=True)
+    assert integer(2048.0, "f", "k", 1, 65536) == 2048
+    with pytest.raises(RecordingError, match="whole number"):
+        integer(2048.5, "f", "k", 1, 65536)
