@@ -5,12 +5,15 @@
 - ``tdm evaluate RECORDING`` writes ``RECORDING/tdm/metrics.json`` and the plots, and prints a table;
 - ``tdm info RECORDING`` summarises a recording.
 
-Bad input: one line on stderr naming the file, the place and what is wrong, exit code 2.
+Bad input: one line on stderr naming the file, the place and what is wrong, exit code 2. Outputs
+appear whole or not at all (:mod:`tdm.staging`); an output that cannot be written (a full disk) prints
+``error: <DIR>: writing: no space left on device``, exit code 2; Ctrl-C exits with 130, SIGTERM with 143.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 
@@ -45,45 +48,68 @@ def build_parser() -> argparse.ArgumentParser:
 
 def run_command(recording: Path, out: Path | None = None, fusion: str = "simple", lidar_source: str = "auto",
                 workers: int = 2, progress: bool | None = None):
-    """``tdm run`` as a function (used by ``raysim run``)."""
+    """``tdm run`` as a function (used by ``raysim run``); its files appear in ``out`` together or not at all."""
     from tdm.io import read_manifest
     from tdm.pipeline import TdmConfig, run_tdm
+    from tdm.staging import StagedOutputs
 
     read_manifest(recording)  # a recording directory at all?
     config = TdmConfig.for_recording(recording, fusion=fusion, lidar_source=lidar_source, workers=max(0, int(workers)))
-    return run_tdm(recording, out, config, progress=sys.stderr.isatty() if progress is None else progress)
+    out_dir = Path(out) if out is not None else Path(recording) / "tdm"
+    with StagedOutputs(out_dir) as staged:
+        result = run_tdm(recording, staged.path, config, progress=sys.stderr.isatty() if progress is None else progress)
+        staged.commit()
+    result.out_dir = out_dir
+    return result
 
 
 def evaluate_command(recording: Path, plots: bool = True) -> dict:
-    """``tdm evaluate`` as a function: metrics.json and the plots; returns the metrics."""
+    """``tdm evaluate`` as a function: metrics.json and the plots (together or not at all); returns the metrics."""
     from tdm.evaluate import evaluate, write_metrics
     from tdm.io import read_manifest
+    from tdm.staging import StagedOutputs
 
     read_manifest(recording)  # a recording directory at all?
     metrics = evaluate(recording)
-    write_metrics(recording, metrics)
-    if plots:
-        from tdm.plots import plot_errors, plot_tracks
+    with StagedOutputs(Path(recording) / "tdm") as staged:
+        write_metrics(staged.root, metrics)  # writes <root>/tdm/metrics.json, i.e. into staged.path
+        if plots:
+            from tdm.plots import plot_errors, plot_tracks
 
-        out = Path(recording) / "tdm"
-        plot_tracks(recording, out / "tracks.png")
-        plot_errors(recording, metrics, out / "errors.png")
+            plot_tracks(recording, staged.path / "tracks.png")
+            plot_errors(recording, metrics, staged.path / "errors.png")
+        staged.commit()
     return metrics
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``tdm`` console script."""
+    """Entry point of the ``tdm`` console script (exit codes: 0, 2 bad input or unwritable output, 130, 143)."""
+    from tdm.staging import EXIT_TERMINATED, sigterm_as_interrupt
+
+    with sigterm_as_interrupt() as sigterm:  # SIGTERM ends a command as Ctrl-C does
+        try:
+            return _main(argv)
+        except Exception:
+            if not sigterm.received:
+                raise
+            print("error: terminated; nothing was written", file=sys.stderr)  # it surfaced as another exception
+            return EXIT_TERMINATED
+
+
+def _main(argv: list[str] | None) -> int:
+    from tdm.staging import EXIT_INTERRUPTED, EXIT_TERMINATED, OutputWriteError, Terminated, is_write_fault
+
     parser = build_parser()
+    args = None
     try:
         args = parser.parse_args(argv)
         if args.command == "info":
-            from tdm.io import read_manifest, read_ownship
+            from tdm.recording.summary import summarise
 
-            manifest = read_manifest(args.recording)
-            nav = read_ownship(args.recording)
-            print(f"{args.recording}: scenario {manifest.get('scenario')}, seed {manifest.get('seed')}, "
-                  f"{manifest.get('duration_s')} s, sensors {', '.join(manifest.get('sensors_rendered', [])) or 'none'}")
-            print(f"  own ship: {nav['t'].shape[0]} navigation samples, {nav['t'][-1]:.1f} s")
+            summary = summarise(args.recording)  # every file checked as far as its headers (tdm.recording)
+            print("\n".join(summary.lines(args.recording)))
+            for what, n in sorted(summary.warnings.items()):
+                print(f"warning: {what}: {n}", file=sys.stderr)
         elif args.command == "run":
             if args.workers < 0:
                 raise RecordingError("command line", "--workers", "must be >= 0")
@@ -98,10 +124,23 @@ def main(argv: list[str] | None = None) -> int:
 
             metrics = evaluate_command(args.recording, plots=not args.no_plots)
             print(format_table(metrics))
+            for what, n in sorted((metrics.get("warnings") or {}).items()):
+                print(f"warning: {what}: {n}", file=sys.stderr)
         return 0
     except RecordingError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
+    except OSError as exc:
+        if not is_write_fault(exc):
+            raise
+        where = exc.directory if isinstance(exc, OutputWriteError) else getattr(args, "out", None) or exc.filename
+        text = exc.strerror or os.strerror(exc.errno)
+        print(f"error: {where}: writing: {text[:1].lower() + text[1:]}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt as exc:
+        how = "terminated" if isinstance(exc, Terminated) else "interrupted"
+        print(f"error: {how}; nothing was written", file=sys.stderr)
+        return EXIT_TERMINATED if isinstance(exc, Terminated) else EXIT_INTERRUPTED
 
 
 if __name__ == "__main__":  # pragma: no cover
