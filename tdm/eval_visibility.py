@@ -6,19 +6,18 @@ sweep at a time; only what the (E, K) masks need is kept.
 
 Sweep files (docs/formats.md, "What tdm evaluate refuses"):
 
-- a file cut short (zero bytes, or a zip archive without its end: the renderer stopped while
-  writing it) is a *warning*, counted in the returned warnings: that sweep saw nothing;
-- anything else that does not read as the format says (not an NPZ, an array of the wrong
-  dtype or shape, lengths that disagree, non-finite times or angles, an array header that
-  declares more data than its file holds) is an *error* (:class:`tdm.errors.RecordingError`);
+- a file that is not a readable archive (zero bytes, not a zip, cut short, damaged array data:
+  what a crash or a broken copy leaves) is a *warning*, counted in the returned warnings under
+  the same key as ``tdm run`` counts it (:mod:`tdm.recording.npz`): that sweep saw nothing;
+- anything else that does not read as the format says (an array of the wrong dtype or shape,
+  lengths that disagree, non-finite times or angles, an array header that declares more data
+  than its file holds, a pickled array) is an *error* (:class:`tdm.errors.RecordingError`);
 - sweeps without the ray-truth arrays (made before they existed) make the sensor's
   visibility its range, as before.
 """
 
 from __future__ import annotations
 
-import zipfile
-import zlib
 from array import array
 from pathlib import Path
 
@@ -27,6 +26,8 @@ import numpy as np
 from tdm.errors import RecordingError
 from tdm.eval_params import EvalParams
 from tdm.eval_truth import TruthAtEpochs
+from tdm.recording.npz import ArrayHeader, Unreadable, load_arrays, read_layout
+from tdm.recording.sweeps import unreadable_warning
 
 #: Half-width of the window about an epoch in which a LiDAR hit, or the radar's view of an object, makes it
 #: visible, s (task definition).
@@ -34,8 +35,6 @@ VISIBLE_WINDOW_S = 0.5
 #: Fewest spokes of a revolution whose rays must reach an object for the radar to see it (0.5 deg at 2048
 #: spokes; a radar plot needs 3 spokes too, docs/tdm.md).
 RADAR_VISIBLE_MIN_SPOKES = 3
-#: First bytes of a zip archive (an NPZ file).
-ZIP_MAGIC = b"PK\x03\x04"
 #: Arrays read from a LiDAR sweep: name -> (accepted dtype kinds, ndim).
 LIDAR_ARRAYS = {"object_id": ("iu", 1), "time": ("f", 1)}
 #: Arrays read from a radar sweep: name -> (accepted dtype kinds, ndim).
@@ -43,68 +42,42 @@ RADAR_ARRAYS = {"object_id": ("iu", 1), "object_spokes": ("iu", 1), "time": ("f"
                 "heading_deg": ("f", 1)}
 #: Returned by :func:`load_sweep` for a sweep without the ray-truth arrays.
 NO_RAY_TRUTH = "no ray truth"
-#: Exceptions of reading a zip archive or an NPY array that mean the file is not what its name says.
-_UNREADABLE = (zipfile.BadZipFile, zlib.error, OSError, ValueError, EOFError, NotImplementedError, KeyError)
-
-
 def _count(warnings: dict[str, int], what: str) -> None:
     warnings[what] = warnings.get(what, 0) + 1
 
 
-def _cut_short(file: Path) -> bool:
-    """Zero bytes, or a zip archive's start without its end (the central directory is written last)."""
-    if file.stat().st_size == 0:
-        return True
-    with open(file, "rb") as handle:
-        magic = handle.read(len(ZIP_MAGIC))
-    return magic == ZIP_MAGIC and not zipfile.is_zipfile(file)
-
-
-def _read_member(archive: zipfile.ZipFile, file: Path, name: str, kinds: str, ndim: int) -> np.ndarray:
-    """One array of an NPZ, its header checked (dtype kind, ndim, size against the member's) before reading."""
-    info = archive.getinfo(f"{name}.npy")
-    with archive.open(info) as handle:
-        version = np.lib.format.read_magic(handle)
-        if version == (1, 0):
-            shape, _, dtype = np.lib.format.read_array_header_1_0(handle)
-        elif version == (2, 0):
-            shape, _, dtype = np.lib.format.read_array_header_2_0(handle)
-        else:
-            raise RecordingError(str(file), name, f"NPY format version {version} not supported")
-    if dtype.hasobject or dtype.kind not in kinds or len(shape) != ndim:
-        raise RecordingError(str(file), name, f"array of dtype {dtype} and shape {shape}: expected {ndim}-D of kind "
-                                              f"{' or '.join(repr(k) for k in kinds)} (docs/formats.md)")
-    if int(np.prod(shape, dtype=np.float64)) * dtype.itemsize > info.file_size:
-        raise RecordingError(str(file), name, f"header declares shape {shape}, more than the file holds")
-    with archive.open(info) as handle:
-        return np.lib.format.read_array(handle, allow_pickle=False)
+def _check_spec(file: Path, layout: dict[str, ArrayHeader], spec: dict[str, tuple[str, int]]) -> None:
+    """Each array of ``spec``: its header's dtype kind and number of dimensions."""
+    for name, (kinds, ndim) in spec.items():
+        header = layout[name]
+        if header.dtype.kind not in kinds or len(header.shape) != ndim:
+            raise RecordingError(str(file), name, f"array of dtype {header.dtype} and shape {header.shape}: expected "
+                                                  f"{ndim}-D of kind {' or '.join(repr(k) for k in kinds)} (docs/formats.md)")
 
 
 def load_sweep(file: Path, spec: dict[str, tuple[str, int]], sensor: str, warnings: dict[str, int]):
-    """The arrays ``spec`` of one sweep file, checked.
+    """The arrays ``spec`` of one sweep file, checked (headers first: :mod:`tdm.recording.npz`).
 
     Returns
     -------
     dict of arrays, None or :data:`NO_RAY_TRUTH`
-        The arrays; None for a file cut short (counted in ``warnings``); NO_RAY_TRUTH when the
-        file lacks one of the arrays.
+        The arrays; None for a file that is not a readable archive (counted in ``warnings``);
+        NO_RAY_TRUTH when the file lacks one of the arrays.
 
     Raises
     ------
     RecordingError
-        Not an NPZ, or an array not as ``spec`` says (module docstring).
+        An array not as ``spec`` says, or beyond what its file holds (module docstring).
     """
     try:
-        if _cut_short(file):
-            _count(warnings, f"{sensor}/sweeps: files cut short (no end of archive), counted as not seen")
-            return None
-        with zipfile.ZipFile(file) as archive:
-            names = set(archive.namelist())
-            if not all(f"{name}.npy" in names for name in spec):
-                return NO_RAY_TRUTH
-            return {name: _read_member(archive, file, name, kinds, ndim) for name, (kinds, ndim) in spec.items()}
-    except _UNREADABLE as exc:
-        raise RecordingError(str(file), "(file)", f"not a readable NPZ ({type(exc).__name__})") from None
+        layout = read_layout(file)
+        if not all(name in layout for name in spec):
+            return NO_RAY_TRUTH
+        _check_spec(file, layout, spec)
+        return load_arrays(file, tuple(spec))
+    except Unreadable as exc:
+        _count(warnings, f"{unreadable_warning(sensor, exc.reason)}, counted as not seen")
+        return None
 
 
 def _same_length(file: Path, arrays: dict[str, np.ndarray], names: tuple[str, ...]) -> None:
