@@ -1,0 +1,259 @@
+"""Radar CFAR along range (module docstring of :mod:`tdm.frontend.radar`, steps 1-2).
+
+Video levels to linear power, the CA and OS thresholds' multipliers, the training-cell windows
+and the CFAR decision of every candidate cell of a sweep.
+"""
+
+from __future__ import annotations
+
+import math
+from functools import lru_cache
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
+from scipy.optimize import brentq
+
+if TYPE_CHECKING:
+    from tdm.frontend.radar_config import RadarFrontEndConfig
+
+__all__ = ["VIDEO_LEVELS", "ca_alpha", "cfar_mask", "os_alpha", "training_table", "video_power", "video_power_table"]
+
+#: Levels of the 4-bit video (docs/reference.md section 3 table: "1024 samples, 4 bits each (0..15)").
+VIDEO_LEVELS = 16
+
+
+#: Cells per chunk of the CFAR's training-cell gathers (bounded memory: chunk x N values).
+_CHUNK_CELLS = 1 << 16
+#: A video level reads as the power at the centre of its bin: its lower edge plus half a step.
+LEVEL_CENTRE_STEPS = 0.5
+#: Power of level 0 (everything below the first level), units of the mean noise: the noise mean
+#: itself, the zero-noise floor (module docstring of :mod:`tdm.frontend.radar`, step 1).
+FLOOR_POWER = 1.0
+#: Bracket of the OS-CFAR multiplier and the solver's tolerances (alpha lies between these for any
+#: N, k and Pfa the configuration allows).
+_OS_ALPHA_BRACKET = (1e-9, 1e12)
+_OS_ALPHA_TOLERANCE = 1e-12
+#: The high bit of one byte: a level plus ``128 - L`` sets it exactly when the level is >= L.
+_BYTE_HIGH_BIT = 128
+#: Bytes (4-bit levels, one a byte) in one 64-bit word.
+_BYTES_PER_WORD = 8
+
+
+def ca_alpha(n_training: int, pfa: float) -> float:
+    """CA-CFAR multiplier ``alpha = N (Pfa^(-1/N) - 1)`` (exponential noise; docs/reference.md section 5)."""
+    return float(n_training * (pfa ** (-1.0 / n_training) - 1.0))
+
+
+@lru_cache(maxsize=64)
+def os_alpha(n_training: int, rank: int, pfa: float) -> float:
+    """OS-CFAR multiplier for the k-th smallest of N training cells (Rohling 1983, exponential noise).
+
+    Solves ``Pfa = prod_{i=0}^{k-1} (N - i) / (N - i + alpha)`` for alpha.
+    """
+    n_i = n_training - np.arange(rank, dtype=float)
+
+    def log_pfa_error(alpha: float) -> float:
+        return float(np.sum(np.log(n_i / (n_i + alpha)))) - math.log(pfa)
+
+    return float(brentq(log_pfa_error, *_OS_ALPHA_BRACKET, xtol=_OS_ALPHA_TOLERANCE,
+                        rtol=_OS_ALPHA_TOLERANCE))
+
+
+@lru_cache(maxsize=8)
+def video_power_table(threshold_db: float, step_db: float) -> np.ndarray:
+    """(16,) float32 power of each video level, units of the mean noise (module docstring, step 1)."""
+    v = np.arange(VIDEO_LEVELS, dtype=float)
+    p = 10.0 ** ((threshold_db + step_db * (v - LEVEL_CENTRE_STEPS)) / 10.0)
+    p[0] = FLOOR_POWER
+    table = p.astype(np.float32)
+    table.setflags(write=False)
+    return table
+
+
+def video_power(echo: np.ndarray, config: RadarFrontEndConfig) -> np.ndarray:
+    """Linear power of echo values, float32, units of the mean noise.
+
+    Parameters
+    ----------
+    echo : array
+        Integer video levels 0..15 (mapped by :func:`video_power_table`) or floating-point linear
+        power (returned as float32).
+    config : RadarFrontEndConfig
+    """
+    echo = np.asarray(echo)
+    if np.issubdtype(echo.dtype, np.integer):
+        return video_power_table(config.video_threshold_db, config.video_step_db)[np.clip(echo, 0, VIDEO_LEVELS - 1)]
+    return echo.astype(np.float32, copy=False)
+
+
+@lru_cache(maxsize=32)
+def training_table(n_samples: int, first_valid: int, n_training: int, n_guard: int) -> np.ndarray:
+    """(n_samples, N) int64 training-cell sample indices of every CUT, ascending.
+
+    The N nearest samples farther than ``n_guard`` from the CUT inside ``[first_valid, n_samples)``:
+    N/2 each side in the interior, sliding inwards near either end.
+    """
+    if n_samples - first_valid < n_training + 2 * n_guard + 1:
+        raise ValueError(f"{n_samples - first_valid} valid samples cannot hold {n_training} training cells "
+                         f"and 2 x {n_guard} guard cells")
+    d = np.arange(n_guard + 1, n_guard + n_training + 1)
+    ext = np.stack([d, -d], axis=1).ravel()  # +(G+1), -(G+1), +(G+2), ... nearest first
+    idx = np.arange(n_samples)[:, None] + ext[None, :]
+    valid = (idx >= first_valid) & (idx < n_samples)
+    order = np.argsort(~valid, axis=1, kind="stable")[:, :n_training]
+    table = np.sort(np.take_along_axis(idx, order, axis=1), axis=1)
+    table.setflags(write=False)
+    return table
+
+
+def _first_valid_sample(range_m: np.ndarray | None, blanking_m: float) -> int:
+    """Index of the first sample at or beyond the blanking range (0 without ranges)."""
+    if range_m is None or blanking_m <= 0:
+        return 0
+    return int(np.searchsorted(np.asarray(range_m, dtype=float), blanking_m, side="left"))
+
+
+def _lowest_candidate_level(config: RadarFrontEndConfig) -> int:
+    """Lowest video level that can pass CFAR: its power must exceed alpha x the floor (level 0)."""
+    table = video_power_table(config.video_threshold_db, config.video_step_db)
+    return max(int(config.min_echo_level), int(np.searchsorted(table, config.alpha * table[0], side="right")))
+
+
+@lru_cache(maxsize=16)
+def _os_blocking_level(alpha: float, threshold_db: float, step_db: float) -> np.ndarray:
+    """(16,) per CUT level: the lowest level L with ``alpha P(L) >= P(CUT)`` (16 if none).
+
+    OS-CFAR on video passes a CUT exactly when fewer than ``N - k + 1`` training cells reach it.
+    """
+    table = video_power_table(threshold_db, step_db).astype(np.float64)
+    blocking = np.searchsorted(alpha * table, table, side="left")  # first L with alpha P(L) >= P(cut)
+    out = blocking.astype(np.uint8)
+    out.setflags(write=False)
+    return out
+
+
+def _training_values(source: np.ndarray, rows: np.ndarray, cols: np.ndarray, config: RadarFrontEndConfig,
+                     first: int) -> np.ndarray:
+    """(M, N) training values of the CUTs (rows, cols) read from ``source`` (S, N_samples)."""
+    n_samples = source.shape[1]
+    half, guard = config.training_cells // 2, config.guard_cells
+    interior = (cols - guard - half >= first) & (cols + guard + half < n_samples)
+    out = np.empty((rows.size, config.training_cells), dtype=source.dtype)
+    if interior.any():
+        windows = sliding_window_view(source, half, axis=1)  # windows[r, j] = source[r, j:j + half]
+        r, c = rows[interior], cols[interior]
+        out[interior, :half] = windows[r, c - guard - half]
+        out[interior, half:] = windows[r, c + guard + 1]
+    edge = ~interior
+    if edge.any():
+        table = training_table(n_samples, first, config.training_cells, guard)
+        out[edge] = source[rows[edge, None], table[cols[edge]]]
+    return out
+
+
+#: The high bit of every byte of a 64-bit word, and one in every byte (byte-parallel counting).
+_HIGH_BITS = np.uint64(0x8080808080808080)
+_BYTE_ONES = np.uint64(0x0101010101010101)
+
+
+def _byte_words(levels: np.ndarray) -> np.ndarray:
+    """(S N,) uint64 view: element p holds the 8 bytes of the flat uint8 array from position p on."""
+    flat = np.zeros(levels.size + _BYTES_PER_WORD, dtype=np.uint8)  # a word of padding: the last words stay inside
+    flat[:levels.size] = levels.ravel()
+    return np.ndarray(shape=(levels.size,), dtype=np.uint64, buffer=flat, offset=0, strides=(1,))
+
+
+def _count_at_least(words: np.ndarray, starts: np.ndarray, n_words: int, add: np.ndarray) -> np.ndarray:
+    """(M,) how many of the ``8 n_words`` bytes from each start are >= L, ``add = (128 - L) x 0x01..01``.
+
+    Byte-parallel: a 4-bit level b (0..15) plus 128 - L sets the byte's high bit exactly when
+    b >= L, and the sum stays under 256, so no carry crosses into the next byte.
+    """
+    count = np.zeros(starts.size, dtype=np.int64)
+    for w in range(n_words):
+        count += np.bitwise_count((words[starts + _BYTES_PER_WORD * w] + add) & _HIGH_BITS)
+    return count
+
+
+def _cfar_cells(echo: np.ndarray, rows: np.ndarray, cols: np.ndarray, config: RadarFrontEndConfig,
+                first: int) -> np.ndarray:
+    """(M,) bool CFAR decisions for the cells (rows, cols) of ``echo``.
+
+    ``echo`` is uint8 video levels 0..15 or float linear power. OS on video counts the training
+    cells at or above the CUT's blocking level (module docstring, step 2): byte-parallel on 64-bit
+    words when N/2 is a multiple of 8 (the interior cells), else from the gathered training values.
+    """
+    video = np.issubdtype(echo.dtype, np.integer)
+    alpha = config.alpha
+    out = np.empty(rows.size, dtype=bool)
+    n_samples = echo.shape[1]
+    half, guard = config.training_cells // 2, config.guard_cells
+    todo = np.arange(rows.size)
+    if video and config.cfar == "os":
+        blocking = _os_blocking_level(alpha, config.video_threshold_db, config.video_step_db)
+        need = config.training_cells - config.rank + 1
+        if half % _BYTES_PER_WORD == 0:
+            interior = (cols - guard - half >= first) & (cols + guard + half < n_samples)
+            i = np.flatnonzero(interior)
+            words = _byte_words(echo)
+            flat = rows[i].astype(np.int64) * n_samples + cols[i]
+            add = (np.uint64(_BYTE_HIGH_BIT) - blocking[echo[rows[i], cols[i]]].astype(np.uint64)) * _BYTE_ONES
+            count = (_count_at_least(words, flat - guard - half, half // _BYTES_PER_WORD, add)
+                     + _count_at_least(words, flat + guard + 1, half // 8, add))
+            out[i] = count < need
+            todo = np.flatnonzero(~interior)
+    power_table = video_power_table(config.video_threshold_db, config.video_step_db)
+    for start in range(0, todo.size, _CHUNK_CELLS):
+        j = todo[start:start + _CHUNK_CELLS]
+        r, c = rows[j], cols[j]
+        train = _training_values(echo, r, c, config, first)
+        cut = echo[r, c]
+        if video and config.cfar == "os":
+            out[j] = np.count_nonzero(train >= blocking[cut][:, None], axis=1) < need
+            continue
+        if video:
+            train, cut = power_table[train], power_table[cut]
+        if config.cfar == "ca":
+            estimate = train.sum(axis=1, dtype=np.float64) / config.training_cells
+        else:
+            estimate = np.partition(train, config.rank - 1, axis=1)[:, config.rank - 1]
+        out[j] = cut > alpha * estimate
+    return out
+
+
+def cfar_mask(echo: np.ndarray, config: RadarFrontEndConfig, range_m: np.ndarray | None = None) -> np.ndarray:
+    """CFAR detections along range, every spoke (module docstring, steps 1-2).
+
+    Parameters
+    ----------
+    echo : (S, N) array
+        One sweep: integer video levels 0..15, or float linear power (synthetic tests).
+    config : RadarFrontEndConfig
+        CFAR kind, Pfa, training / guard cells, OS rank, video mapping, ``min_echo_level``.
+    range_m : (N,) float, optional
+        Range of each sample, metres; with it, samples nearer than ``config.blanking_m`` hold no
+        data (neither CUT nor training cells).
+
+    Returns
+    -------
+    (S, N) bool
+        True where the CUT's power exceeds ``alpha x`` its training estimate: ``mean`` for CA,
+        ``X_(k)`` for OS (:attr:`RadarFrontEndConfig.alpha`).
+    """
+    echo = np.asarray(echo)
+    if echo.ndim != 2:
+        raise ValueError(f"echo must be 2-D (spokes, samples), not {echo.shape}")
+    first = _first_valid_sample(range_m, config.blanking_m)
+    training_table(echo.shape[1], first, config.training_cells, config.guard_cells)  # validates the size
+    if np.issubdtype(echo.dtype, np.integer):
+        echo = np.clip(echo, 0, VIDEO_LEVELS - 1).astype(np.uint8)
+        candidate = echo >= _lowest_candidate_level(config)  # levels compare as powers (monotone table)
+    else:
+        candidate = echo > 0.0
+    candidate[:, :first] = False
+    rows, cols = np.nonzero(candidate)
+    mask = np.zeros(echo.shape, dtype=bool)
+    hit = _cfar_cells(echo, rows, cols, config, first)
+    mask[rows[hit], cols[hit]] = True
+    return mask

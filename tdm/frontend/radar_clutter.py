@@ -1,0 +1,182 @@
+"""Radar clutter map: beam-integrated power and the local clutter level of a plot
+(module docstring of :mod:`tdm.frontend.radar`, step 5).
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from tdm.frontend.radar_config import RadarFrontEndConfig
+
+__all__ = ["beam_integrated_power", "clutter_map"]
+
+#: Block maxima are floored here (linear power over the mean noise) before they go to dB: no log of 0.
+BLOCK_POWER_FLOOR = 1e-6
+
+
+def _group_spokes(n_spokes: int, wanted: int) -> int:
+    """Largest divisor of ``n_spokes`` not above ``wanted`` (at least 1)."""
+    for g in range(max(1, wanted), 0, -1):
+        if n_spokes % g == 0:
+            return g
+    return 1
+
+
+def _integrate_cells(flat: np.ndarray, excess: np.ndarray, shape: tuple[int, int],
+                     config: RadarFrontEndConfig) -> tuple[np.ndarray, int]:
+    """:func:`beam_integrated_power` from the cells above the floor only (``excess`` = power - 1)."""
+    n_spokes, n_samples = shape
+    g = _group_spokes(n_spokes, max(1, config.integration_spokes // 2))
+    rows, cols = np.divmod(flat, n_samples)
+    groups = np.bincount((rows // g) * n_samples + cols, weights=excess,
+                         minlength=(n_spokes // g) * n_samples).reshape(n_spokes // g, n_samples)
+    integrated = (groups + np.roll(groups, -1, axis=0)) * (0.5 / g) + 1.0
+    return integrated.astype(np.float32), g
+
+
+def beam_integrated_power(power: np.ndarray, config: RadarFrontEndConfig) -> tuple[np.ndarray, int]:
+    """Power averaged over ``integration_spokes`` neighbouring spokes, decimated in azimuth.
+
+    Spokes are summed in groups of ``g = integration_spokes / 2`` (a divisor of the spoke count) and
+    two neighbouring groups make one window: row i is the mean of spokes ``g i .. g i + 2 g - 1``
+    (circular), every sample. A target's echo holds over the beam while the sea's speckle changes
+    from spoke to spoke (docs/reference.md 3.8), so this non-coherent integration lowers the clutter's
+    spikes, not the target. Decimating by g (1.4 deg at 2048 spokes) costs a target's peak at most
+    0.5 dB in a 5.2 deg two-way Gaussian beam.
+
+    Parameters
+    ----------
+    power : (S, N) float
+        Linear power per cell (:func:`video_power`).
+    config : RadarFrontEndConfig
+
+    Returns
+    -------
+    integrated : (S / g, N) float32
+    g : int
+        Spokes per group.
+    """
+    power = np.asarray(power, dtype=np.float64)
+    flat = np.flatnonzero(power != 1.0)
+    return _integrate_cells(flat, power.ravel()[flat] - 1.0, power.shape, config)
+
+
+@lru_cache(maxsize=8)
+def _annulus_offsets(window: tuple[int, int], guard: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
+    """Block offsets (azimuth, range) of a centred window minus its centred guard."""
+    wa, wr = window
+    ga, gr = guard
+    a, r = np.meshgrid(np.arange(wa) - wa // 2, np.arange(wr) - wr // 2, indexing="ij")
+    keep = ~((np.abs(a) <= ga // 2) & (np.abs(r) <= gr // 2))
+    return a[keep], r[keep]
+
+
+def clutter_map(integrated: np.ndarray, group_spokes: int, config: RadarFrontEndConfig) -> np.ndarray:
+    """Seed threshold of every block: the integrated power a plot must reach to stand out of the clutter.
+
+    The integrated sweep (:func:`beam_integrated_power`) is cut into blocks of
+    ``clutter_block_spokes x clutter_block_samples`` cells and each block's maximum is taken. The
+    local clutter level of a block is the ``clutter_quantile`` of the block maxima (in dB) over an
+    annulus of ``clutter_window_blocks`` (azimuth, range) minus ``clutter_guard_blocks`` about it,
+    circular in azimuth and cut at the ends of the range scale (a spatial clutter map, after
+    Nitzberg's scan-to-scan one). The guard keeps a target's own blocks out; other targets fill a
+    few blocks of the annulus, under the quantile. The seed threshold is that level plus
+    ``clutter_margin_db``, at least ``min_seed_db``. Only blocks whose own maximum reaches
+    ``min_seed_db`` are worked out (the others cannot hold a seed and get ``min_seed_db``).
+
+    Parameters
+    ----------
+    integrated : (A, N) float
+        Integrated power over the mean noise, rows ``group_spokes`` spokes apart.
+    group_spokes : int
+    config : RadarFrontEndConfig
+
+    Returns
+    -------
+    (ceil(A / ba), ceil(N / bn)) float32
+        Seed threshold per block, linear power over the mean noise; block (i, j) holds rows
+        ``i ba .. (i + 1) ba - 1`` and samples ``j bn .. (j + 1) bn - 1``, with
+        ``ba = max(1, clutter_block_spokes // group_spokes)``, ``bn = clutter_block_samples``.
+    """
+    block_db, _ = _block_max_db(integrated, group_spokes, config)
+    seed_db = np.full(block_db.shape, config.min_seed_db, dtype=np.float32)
+    bi, bj = np.nonzero(block_db >= config.min_seed_db)
+    if bi.size:
+        seed_db[bi, bj] = np.maximum(_clutter_level_db(block_db, bi, bj, config) + config.clutter_margin_db,
+                                     config.min_seed_db)
+    return (10.0 ** (seed_db / 10.0)).astype(np.float32)
+
+
+def _block_max_db(integrated: np.ndarray, group_spokes: int, config: RadarFrontEndConfig) -> tuple[np.ndarray, int]:
+    """(sb, nb) float32 block maxima of the integrated power in dB, and rows per block ``ba``."""
+    ba = max(1, config.clutter_block_spokes // group_spokes)
+    bn = config.clutter_block_samples
+    a, n = integrated.shape
+    sb, nb = -(-a // ba), -(-n // bn)
+    padded = np.asarray(integrated, dtype=np.float32)
+    if (sb * ba, nb * bn) != (a, n):
+        padded = np.ones((sb * ba, nb * bn), dtype=np.float32)
+        padded[:a, :n] = integrated
+    block_max = np.maximum.reduce(padded.reshape(sb, ba, nb * bn), axis=1)
+    block_max = np.maximum.reduce(block_max.reshape(sb, nb, bn), axis=2)
+    return 10.0 * np.log10(np.maximum(block_max, np.float32(BLOCK_POWER_FLOOR))), ba
+
+
+def _clutter_level_db(block_db: np.ndarray, bi: np.ndarray, bj: np.ndarray, config: RadarFrontEndConfig) -> np.ndarray:
+    """(K,) float32 clutter level (dB) of blocks (bi, bj): the quantile of their annulus's block maxima."""
+    sb, nb = block_db.shape
+    da, dr = _annulus_offsets(tuple(config.clutter_window_blocks), tuple(config.clutter_guard_blocks))
+    rj = bj[:, None] + dr[None, :]
+    inside = (rj >= 0) & (rj < nb)
+    values = np.where(inside, block_db[(bi[:, None] + da[None, :]) % sb, np.clip(rj, 0, nb - 1)], -np.inf)
+    n_valid = inside.sum(axis=1)
+    # the q-quantile of each block's valid values: rank ceil(q n) among them (-inf sort first)
+    rank = values.shape[1] - n_valid + np.maximum(np.ceil(config.clutter_quantile * n_valid).astype(np.int64), 1) - 1
+    q_db = np.empty(bi.size, dtype=np.float32)
+    full = n_valid == values.shape[1]
+    if full.any():  # one rank for all blocks with a whole annulus: partition
+        k = int(rank[full][0])
+        q_db[full] = np.partition(values[full], k, axis=1)[:, k]
+    if (~full).any():
+        part = np.sort(values[~full], axis=1)
+        q_db[~full] = part[np.arange(part.shape[0]), rank[~full]]
+    return q_db
+
+
+
+def _margin_over_clutter_db(lab: np.ndarray, spoke: np.ndarray, sample: np.ndarray, n_labels: int,
+                            eligible: np.ndarray, integrated: np.ndarray, g: int,
+                            config: RadarFrontEndConfig) -> np.ndarray:
+    """(n_labels,) float32: each eligible plot's peak beam-integrated power over its clutter level, dB
+    (-inf for the others and for plots with no cell above the lowest seed threshold).
+
+    A cell of spoke group k lies in integration windows k - 1 and k and takes the larger; a plot's
+    peak is its largest, and the clutter level is worked out for the peak's block only
+    (:func:`clutter_map` gives the same threshold for every block).
+    """
+    margin_db = np.full(n_labels, -np.inf, dtype=np.float32)
+    a = integrated.shape[0]
+    k = spoke // g
+    before, here = integrated[(k - 1) % a, sample], integrated[k, sample]
+    value = np.maximum(before, here)
+    # only cells above the lowest seed threshold can be a kept plot's peak
+    cells = np.flatnonzero((value >= np.float32(10.0 ** (config.min_seed_db / 10.0))) & eligible[lab])
+    if cells.size == 0:
+        return margin_db
+    value, lab_c = value[cells], lab[cells]
+    row = np.where(before[cells] > here[cells], (k[cells] - 1) % a, k[cells])
+    peak = np.full(n_labels, -np.inf, dtype=np.float32)
+    np.maximum.at(peak, lab_c, value)
+    at_peak = np.flatnonzero(value == peak[lab_c])
+    labels, first = np.unique(lab_c[at_peak], return_index=True)
+    peak_cell = at_peak[first]
+    peak_db = 10.0 * np.log10(peak[labels])
+    block_db, ba = _block_max_db(integrated, g, config)
+    level_db = _clutter_level_db(block_db, row[peak_cell] // ba,
+                                 sample[cells[peak_cell]] // config.clutter_block_samples, config)
+    margin_db[labels] = peak_db - level_db
+    return margin_db
