@@ -42,6 +42,10 @@ SIZE_CHECK = _at_least(MIN_SIZE_M, "below a centimetre nothing is seen (the LiDA
 RESOLVE_CHECK = _at_least(MIN_RADAR_RESOLVE_M, "rays per spoke grow as 1 / resolve_m^2 (4,056 at 0.5 m, "
                                                "92,796 at 0.1 m): hours per revolution")
 
+#: Positions further than this from the origin are rejected: the local frame
+#: (transverse Mercator about the origin, flat sea) is meant for a local scene.
+MAX_DISTANCE_FROM_ORIGIN_M = 50_000.0
+
 #: Most objects in a scene, the own ship included. Each object is posed for every ray batch and
 #: adds a truth line every 0.1 s (266 bytes): 1,000 objects for the default 300 s write 0.8 GB of
 #: truth.jsonl; the thesis's scenario has 17.

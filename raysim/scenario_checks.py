@@ -4,7 +4,7 @@
 one own-ship motion, unique names and MMSIs, known materials, keys that apply to an object's
 kind, the run's times within what the outputs can stamp (:mod:`raysim.limits`), the scene's
 object count, the trajectory CSV's coverage, and every position within
-:data:`raysim.scenario.MAX_DISTANCE_FROM_ORIGIN_M` of the origin. Each failure is one
+:data:`raysim.limits.MAX_DISTANCE_FROM_ORIGIN_M` of the origin. Each failure is one
 :class:`raysim.errors.InputError` naming the key path.
 """
 
@@ -16,7 +16,8 @@ import numpy as np
 
 from raysim import limits
 from raysim.errors import InputError
-from raysim.scenario import MAX_DISTANCE_FROM_ORIGIN_M, LatLon, Scenario
+from raysim.limits import MAX_DISTANCE_FROM_ORIGIN_M
+from raysim.scenario_format import LatLon, Scenario
 from raysim.schema import Context
 
 
