@@ -297,31 +297,30 @@ BENCHMARKS = ("ray_engine", "lidar", "radar", "rosbag", "tdm_speed", "tdm_criter
 def cmd_bench(args) -> int:
     """Run the benchmarks and print their tables (the committed results files are left untouched).
 
-    The ray engine's benchmark lives in the package (:func:`raysim.benchmarking.main`);
-    the others are scripts of the source tree's benchmarks/ folder, run when it is there.
+    The benchmarks are scripts of the source tree's benchmarks/ folder (the ray engine's
+    first, one run of it); an installed copy without that folder says so in one line (exit 1).
     With ``--json`` the file holds ``{"ray_engine": ..., "<script>": ...}``.
     """
     import importlib.util
     import json
     import tempfile
 
-    from raysim import benchmarking
-
     folder = Path(__file__).resolve().parents[1] / "benchmarks"
+    if not (folder / "ray_engine.py").is_file():
+        print(f"error: raysim bench runs the scripts of the source tree's benchmarks/ folder; {folder} has none",
+              file=sys.stderr)
+        return 1
     combined = {}
     with tempfile.TemporaryDirectory() as tmp:
-        json_path = Path(tmp) / "ray_engine.json"
-        if benchmarking.main(quick=args.quick, json_path=json_path) != 0:
-            return 1
-        combined["ray_engine"] = json.loads(json_path.read_text(encoding="utf-8"))
         for name in BENCHMARKS:
-            if name == "ray_engine" or not (folder / f"{name}.py").is_file():
+            if not (folder / f"{name}.py").is_file():
                 continue
             spec = importlib.util.spec_from_file_location(f"raysim_bench_{name}", folder / f"{name}.py")
             module = importlib.util.module_from_spec(spec)
             spec.loader.exec_module(module)
             json_path = Path(tmp) / f"{name}.json"
             argv = ["--out", str(Path(tmp) / f"{name}.md"), "--json", str(json_path)] + (["--quick"] if args.quick else [])
+            argv += ["--runs", "1"] if name == "ray_engine" else []
             if module.main(argv) != 0:
                 return 1
             combined[name] = json.loads(json_path.read_text(encoding="utf-8"))

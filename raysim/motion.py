@@ -87,7 +87,8 @@ class ConstantVelocity:
     def poses(self, t_s: np.ndarray) -> Poses:
         t = np.atleast_1d(np.asarray(t_s, dtype=float))
         zeros = np.zeros(t.shape[0])
-        return Poses(self.position_m + t[:, None] * self.velocity, self.yaw_rad + self.yaw_rate * t, zeros, zeros.copy())
+        position, yaw = constant_velocity_poses(self.position_m, self.velocity, self.yaw_rad, self.yaw_rate, t)
+        return Poses(position, yaw, zeros, zeros.copy())
 
     def velocity_mps(self, t_s: np.ndarray) -> np.ndarray:
         return np.broadcast_to(self.velocity, (np.atleast_1d(t_s).shape[0], 3)).copy()
@@ -147,14 +148,13 @@ class SampledTrack:
         self.duration_s = (n - 1) * self.dt_s
 
     def _index(self, t_s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        u = np.clip(np.atleast_1d(np.asarray(t_s, dtype=float)) / self.dt_s, 0.0, self.x.shape[0] - 1)
-        i = np.minimum(u.astype(np.int64), max(self.x.shape[0] - 2, 0))
-        return i, u - i
+        n = self.x.shape[0]
+        return track_index(np.atleast_1d(np.asarray(t_s, dtype=float)), self.dt_s, n - 1, max(n - 2, 0))
 
     def _lerp(self, a: np.ndarray, i: np.ndarray, f: np.ndarray) -> np.ndarray:
         if a.shape[0] == 1:
             return np.full(i.shape[0], a[0])
-        return a[i] + (a[i + 1] - a[i]) * f
+        return lerp(a[i], a[i + 1], f)
 
     def poses(self, t_s: np.ndarray) -> Poses:
         i, f = self._index(t_s)
@@ -319,14 +319,12 @@ class WaveMotion:
         self.heave = (float(heave_amplitude_m), 2 * np.pi / heave_period_s)
         self.phases = rng.uniform(0.0, 2 * np.pi, size=3)
         self.max_heave_speed_mps = self.heave[0] * self.heave[1]
+        #: (9,) amplitude, angular frequency (rad/s) and phase (rad) of roll, pitch (marine) and heave
+        self.params = np.array([*self.roll, self.phases[0], *self.pitch, self.phases[1], *self.heave, self.phases[2]])
 
     def angles(self, t_s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(roll_rad FLU, pitch_rad FLU, heave_m), each (N,)."""
-        t = np.atleast_1d(np.asarray(t_s, dtype=float))
-        roll = self.roll[0] * np.sin(self.roll[1] * t + self.phases[0])
-        pitch_marine = self.pitch[0] * np.sin(self.pitch[1] * t + self.phases[1])
-        heave = self.heave[0] * np.sin(self.heave[1] * t + self.phases[2])
-        return roll, -pitch_marine, heave
+        return wave_angles(self.params, np.atleast_1d(np.asarray(t_s, dtype=float)))
 
     def heave_rate_mps(self, t_s: np.ndarray) -> np.ndarray:
         t = np.atleast_1d(np.asarray(t_s, dtype=float))
@@ -358,3 +356,84 @@ class ShipMotion:
 
     def yaw_rate_rps(self, t_s: np.ndarray) -> np.ndarray:
         return self.track.yaw_rate_rps(t_s)
+
+
+# --------------------------------------------------------------------------- vectorised kernels
+# The arithmetic of the motions, for one body or for many at once (one parameter
+# set per time): the motions below use these, and so does the ray engine's pose
+# bank (raysim.scene.poses), which evaluates all bodies of a kind in one pass.
+
+
+def constant_velocity_poses(position_m, velocity_mps, yaw_rad, yaw_rate_rps, t_s: np.ndarray):
+    """Positions ``p0 + t v`` and yaws ``yaw0 + rate t`` of constant-velocity bodies.
+
+    Parameters
+    ----------
+    position_m, velocity_mps : (3,) or (N, 3) float64
+        Position at t = 0 (metres) and velocity (m/s), one body or one per time.
+    yaw_rad, yaw_rate_rps : float or (N,) float64
+        Yaw at t = 0 (radians) and yaw rate (rad/s).
+    t_s : (N,) float64
+        Times, seconds.
+
+    Returns
+    -------
+    position : (N, 3) float64
+        Metres.
+    yaw : (N,) float64
+        Radians.
+    """
+    return position_m + t_s[:, None] * velocity_mps, yaw_rad + yaw_rate_rps * t_s
+
+
+def track_index(t_s: np.ndarray, dt_s, last, i_max) -> tuple[np.ndarray, np.ndarray]:
+    """Sample index and fraction of times on uniform grids (times outside hold the end samples).
+
+    Parameters
+    ----------
+    t_s : (N,) float64
+        Times, seconds.
+    dt_s : float or (N,) float64
+        Grid step, seconds.
+    last : int or (N,) float
+        Index of the last sample (``n - 1``).
+    i_max : int or (N,) int64
+        Largest left index of an interval (``max(n - 2, 0)``).
+
+    Returns
+    -------
+    i : (N,) int64
+        Left sample of each time's interval.
+    f : (N,) float64
+        Fraction in [0, 1] (may reach 1 at the last sample).
+    """
+    u = np.clip(t_s / dt_s, 0.0, last)
+    i = np.minimum(u.astype(np.int64), i_max)
+    return i, u - i
+
+
+def lerp(a: np.ndarray, b: np.ndarray, f: np.ndarray) -> np.ndarray:
+    """Linear interpolation ``a + (b - a) f`` (any broadcastable shapes)."""
+    return a + (b - a) * f
+
+
+def wave_angles(params: np.ndarray, t_s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Wave-induced roll, pitch and heave: one sinusoid each.
+
+    Parameters
+    ----------
+    params : (9,) or (9, N) float64
+        Amplitude, angular frequency (rad/s) and phase (rad) of roll (radians), pitch
+        (radians, marine: positive bow up) and heave (metres), as :attr:`WaveMotion.params`.
+    t_s : (N,) float64
+        Times, seconds.
+
+    Returns
+    -------
+    roll_rad, pitch_rad, heave_m : (N,) float64
+        FLU roll and pitch (the marine pitch's sign flipped), heave.
+    """
+    roll = params[0] * np.sin(params[1] * t_s + params[2])
+    pitch_marine = params[3] * np.sin(params[4] * t_s + params[5])
+    heave = params[6] * np.sin(params[7] * t_s + params[8])
+    return roll, -pitch_marine, heave

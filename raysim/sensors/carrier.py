@@ -15,9 +15,17 @@ A sensor whose body-frame rays repeat (the LiDAR's beams depend only on the
 encoder azimuth and the laser) can precompute the own-ship hits once:
 :meth:`CarrierScene.carrier_hits` on all of them, then pass the looked-up
 :class:`raysim.scene.Hits` to :meth:`CarrierScene.cast`.
+
+This is the ray engine's one own-ship mechanism (the renderers and
+``benchmarks/ray_engine.py`` use it): :class:`raysim.scene.Scene` itself knows
+no carrier, and two plain scenes do the work, one of the world without the own
+ship and one of the own ship's body-frame mesh alone (a static scene, so no
+pose is ever evaluated for it).
 """
 
 from __future__ import annotations
+
+from typing import Sequence
 
 import numpy as np
 
@@ -36,6 +44,8 @@ class CarrierScene:
         Truth id of the own ship (0).
     sea_material : int
         Material index of sea hits.
+    sea : bool
+        Include the flat sea surface z = 0.
 
     Notes
     -----
@@ -43,10 +53,11 @@ class CarrierScene:
     body-frame directions); all other normals are in the world frame.
     """
 
-    def __init__(self, objects, carrier_id: int = 0, sea_material: int = -1):
+    def __init__(self, objects: Sequence[SceneObject], carrier_id: int = 0, sea_material: int = -1, sea: bool = True):
         carrier = [o for o in objects if o.object_id == carrier_id]
         self.sea_material = sea_material
-        self.world = Scene([o for o in objects if o.object_id != carrier_id], sea=True, sea_material=sea_material)
+        self.sea = bool(sea)
+        self.world = Scene([o for o in objects if o.object_id != carrier_id], sea=self.sea, sea_material=sea_material)
         self.carrier = None
         if carrier:
             body = carrier[0]
@@ -54,23 +65,41 @@ class CarrierScene:
                                               Stationary([0.0, 0.0, 0.0]))], sea=False)
 
     def carrier_hits(self, origins_body_m: np.ndarray, directions_body: np.ndarray, max_range_m=np.inf) -> Hits:
-        """Hits of body-frame rays on the own ship alone (body-frame normals)."""
+        """Hits of body-frame rays on the own ship alone.
+
+        Parameters
+        ----------
+        origins_body_m, directions_body : (N, 3) float
+            Ray origins (metres) and unit directions in the own-ship body frame.
+        max_range_m : float or (N,) float
+            Hits farther than this count as no hit, metres.
+
+        Returns
+        -------
+        Hits
+            N hits, normals in the body frame (no hit anywhere if the world has no own ship).
+        """
         n = origins_body_m.shape[0]
         if self.carrier is None:
             return Hits.empty(n)
         return self.carrier.cast(origins_body_m, directions_body, np.zeros(n), max_range_m=max_range_m)
 
-    def cast(self, origins_world_m, directions_world, times_s, origins_body_m=None, directions_body=None,
+    def cast(self, origins_world_m: np.ndarray, directions_world: np.ndarray, times_s: np.ndarray,
+             origins_body_m: np.ndarray | None = None, directions_body: np.ndarray | None = None,
              max_range_m=np.inf, carrier_hits: Hits | None = None) -> tuple[Hits, np.ndarray]:
         """First hits of rays given in the world and in the own-ship body frame.
 
         Parameters
         ----------
         origins_world_m, directions_world : (N, 3) float
+            Ray origins (metres) and unit directions in the world (ENU) frame.
         times_s : (N,) float
+            Time of each ray, seconds since scenario start.
         origins_body_m, directions_body : (N, 3) float
-            The same rays in the own-ship body frame (needed unless ``carrier_hits`` is given).
-        max_range_m : float
+            The same rays in the own-ship body frame at their times (needed unless
+            ``carrier_hits`` is given).
+        max_range_m : float or (N,) float
+            Hits farther than this count as no hit, metres.
         carrier_hits : Hits, optional
             Precomputed own-ship hits of these rays (:meth:`carrier_hits`).
 
@@ -81,9 +110,12 @@ class CarrierScene:
         on_carrier : (N,) bool
             Which rays hit the own ship first (their normals are body-frame).
         """
+        n = np.shape(origins_world_m)[0]
+        if carrier_hits is None and (np.shape(origins_body_m) != (n, 3) or np.shape(directions_body) != (n, 3)):
+            raise ValueError("the body-frame rays must be (N, 3) like the world rays")
         own = carrier_hits if carrier_hits is not None else self.carrier_hits(origins_body_m, directions_body, max_range_m)
         on_carrier = own.object_id != NO_HIT
-        if on_carrier.any():
+        if self.sea and on_carrier.any():
             # the sea can come first where a ray meets the hull below the waterline
             idx = np.flatnonzero(on_carrier)
             sea = intersect_sea(origins_world_m[idx, 2], directions_world[idx, 2])

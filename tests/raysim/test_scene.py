@@ -472,7 +472,7 @@ def test_static_culling_matches_plain_cast(dense):
     assert (ref_id >= 0).mean() > (0.3 if dense else 0.005)
     culled, plain = Scene(objects, sea=False), Scene(objects, sea=False, cull=False)
     # white box: the sparse scene really takes the culled path, the dense one casts every ray
-    from raysim.scene import _Batch
+    from raysim.scene.rays import RayBatch as _Batch
 
     batch = _Batch(o, d, t, None)
     culled._prepare(batch)
@@ -498,9 +498,21 @@ def test_static_culling_matches_plain_cast(dense):
         np.testing.assert_array_equal(hits.primitive[sea], -1)
 
 
+def _ray_engine_bench():
+    """benchmarks/ray_engine.py loaded by path (benchmarks/ is a folder of scripts, not a package)."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[2] / "benchmarks" / "ray_engine.py"
+    spec = importlib.util.spec_from_file_location("bench_ray_engine", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
 @pytest.mark.bench
 def test_benchmark_functions_run():
-    from raysim import benchmarking
+    benchmarking = _ray_engine_bench()
 
     st = benchmarking.bench_static(n_firings=200, reps=1, with_embreex=True)
     assert st["rays"] == 6400 and st["raw_o3d_rays_per_s"] > 0 and st["fraction_of_raw"] > 0
@@ -550,7 +562,7 @@ def _motions_of_every_kind():
 
 
 def test_pose_bank_matches_each_motion():
-    from raysim.scene import _PoseBank
+    from raysim.scene.poses import PoseBank as _PoseBank
 
     motions = _motions_of_every_kind()
     bank = _PoseBank(motions)
@@ -609,67 +621,74 @@ def _sensor_rays(motion, n_azimuths: int = 400, mount=(1.5, 0.0, 3.0)):
     return o, d, times, o_b, d_b, r
 
 
-@pytest.mark.parametrize("with_rotation", [False, True])
-def test_carrier_fast_path_equals_plain_cast(with_rotation):
-    from raysim.scene import Carrier
+def _carrier_cast(objects, o, d, times, o_b, d_b, r, carrier_id=0, **kwargs):
+    """CarrierScene's hits, own-ship normals rotated to the world frame with ``r`` (as a sensor does)."""
+    from raysim.sensors.carrier import CarrierScene
 
+    sea = kwargs.pop("sea", True)
+    hits, on_carrier = CarrierScene(objects, carrier_id=carrier_id, sea_material=kwargs.pop("sea_material", -1),
+                                    sea=sea).cast(o, d, times, o_b, d_b, **kwargs)
+    hits.normal[on_carrier] = np.einsum("nij,nj->ni", r[on_carrier], hits.normal[on_carrier].astype(np.float64))
+    return hits
+
+
+@pytest.mark.parametrize("sea", [False, True])
+def test_carrier_fast_path_equals_plain_cast(sea):
     objects, motion = _own_ship_scene()
     o, d, times, o_b, d_b, r = _sensor_rays(motion)
-    carrier = Carrier(0, o_b, d_b, r if with_rotation else None)
     ref_range, ref_ids = brute_force(objects, o, d, times)
     assert (ref_ids == 0).sum() > 500 and len(np.unique(ref_ids[ref_ids > 0])) >= 4  # sees its deck, mast and others
-    for sea in (False, True):
-        scene = Scene(objects, sea=sea, sea_material=9)
-        plain = scene.cast(o, d, times)
-        fast = scene.cast(o, d, times, carrier=carrier)
-        exp_ids, exp_range = ref_ids, ref_range
-        if sea:
-            sea_t = intersect_sea(o[:, 2], d[:, 2])
-            exp_ids = np.where(sea_t < ref_range, SEA_ID, ref_ids)
-            exp_range = np.minimum(ref_range, sea_t)
-        for hits in (plain, fast):
-            np.testing.assert_array_equal(hits.object_id, exp_ids)
-            np.testing.assert_allclose(hits.range_m, exp_range, rtol=0, atol=5e-4)
-        np.testing.assert_array_equal(fast.primitive, plain.primitive)
-        np.testing.assert_array_equal(fast.material, plain.material)
-        np.testing.assert_allclose(fast.normal, plain.normal, atol=1e-5)
-        own = fast.object_id == 0
-        assert np.all(fast.material[own] >= 10) and np.all(np.einsum("ij,ij->i", fast.normal, d) <= 1e-7)
-        # the deck seen from above: world normal = the ship's body z axis
-        top = own & (np.abs(fast.range_m - (3.0 - 1.0) / -d_b[:, 2]) < 1e-3) & (d_b[:, 2] < -0.5)
-        assert top.sum() > 50
-        np.testing.assert_allclose(fast.normal[top], r[top][:, :, 2], atol=1e-5)
+    scene = Scene(objects, sea=sea, sea_material=9)
+    plain = scene.cast(o, d, times)
+    fast = _carrier_cast(objects, o, d, times, o_b, d_b, r, sea=sea, sea_material=9)
+    exp_ids, exp_range = ref_ids, ref_range
+    if sea:
+        sea_t = intersect_sea(o[:, 2], d[:, 2])
+        exp_ids = np.where(sea_t < ref_range, SEA_ID, ref_ids)
+        exp_range = np.minimum(ref_range, sea_t)
+    for hits in (plain, fast):
+        np.testing.assert_array_equal(hits.object_id, exp_ids)
+        np.testing.assert_allclose(hits.range_m, exp_range, rtol=0, atol=5e-4)
+    np.testing.assert_array_equal(fast.primitive, plain.primitive)
+    np.testing.assert_array_equal(fast.material, plain.material)
+    np.testing.assert_allclose(fast.normal, plain.normal, atol=1e-5)
+    own = fast.object_id == 0
+    assert np.all(fast.material[own] >= 10) and np.all(np.einsum("ij,ij->i", fast.normal, d) <= 1e-7)
+    # the deck seen from above: world normal = the ship's body z axis
+    top = own & (np.abs(fast.range_m - (3.0 - 1.0) / -d_b[:, 2]) < 1e-3) & (d_b[:, 2] < -0.5)
+    assert top.sum() > 50
+    np.testing.assert_allclose(fast.normal[top], r[top][:, :, 2], atol=1e-5)
     # a range limit, and brute-force (no culling) mode
-    limited = Scene(objects, sea=True).cast(o, d, times, max_range_m=20.0, carrier=carrier)
+    limited = _carrier_cast(objects, o, d, times, o_b, d_b, r, max_range_m=20.0)
     expected = Scene(objects, sea=True, cull=False).cast(o, d, times, max_range_m=20.0)
     np.testing.assert_array_equal(limited.object_id, expected.object_id)
     np.testing.assert_allclose(limited.range_m, expected.range_m, rtol=0, atol=5e-4)
 
 
 def test_carrier_alone_and_bad_carriers():
-    from raysim.scene import Carrier
+    from raysim.sensors.carrier import CarrierScene
 
     objects, motion = _own_ship_scene(with_others=False)
     o, d, times, o_b, d_b, r = _sensor_rays(motion, n_azimuths=100)
     scene = Scene(objects, sea=True)
-    fast = scene.cast(o, d, times, carrier=Carrier(0, o_b, d_b))
+    fast = _carrier_cast(objects, o, d, times, o_b, d_b, r)
     plain = scene.cast(o, d, times)
     np.testing.assert_array_equal(fast.object_id, plain.object_id)
     assert (fast.object_id == 0).sum() > 100
-    # an id that is no moving object of the scene: ignored
-    other = scene.cast(o, d, times, carrier=Carrier(77, o_b, d_b))
+    # an id that is no object of the scene: no carrier, the world cast as usual
+    other = _carrier_cast(objects, o, d, times, o_b, d_b, r, carrier_id=77)
     np.testing.assert_array_equal(other.object_id, plain.object_id)
     with pytest.raises(ValueError):
-        scene.cast(o, d, times, carrier=Carrier(0, o_b[:-1], d_b))
+        CarrierScene(objects).cast(o, d, times, o_b[:-1], d_b)
     with pytest.raises(ValueError):
-        scene.cast(o, d, times, carrier=Carrier(0, o_b, d_b, np.zeros((3, 3, 3))))
+        CarrierScene(objects).cast(o, d, times, o_b, d_b[:, :2])
 
 
 def test_benchmark_report_and_main(tmp_path, monkeypatch, capsys):
-    """The report formatter and ``benchmarking.main`` on a tiny real measurement (fast, not a benchmark)."""
+    """The report formatter and ``run`` of benchmarks/ray_engine.py on a tiny real measurement (fast, not a benchmark)."""
     import json
 
-    from raysim import benchmarking
+    benchmarking = _ray_engine_bench()
 
     rows = benchmarking.bench_moving(counts=(1, 2), n_firings=40, reps=1)
     res = {
@@ -682,11 +701,11 @@ def test_benchmark_report_and_main(tmp_path, monkeypatch, capsys):
     figures = benchmarking.key_figures(res)
     assert figures["own ship: ns/ray with it, carrier="] == 40.0 and len(figures) == 4
     text = benchmarking.to_markdown(dict(res, runs=[figures, figures]))
-    assert "| 2 | " in text and "| with own ship, `Scene.cast(..., carrier=Carrier(...))`" in text
+    assert "| 2 | " in text and "| with own ship, `CarrierScene.cast(...)`" in text
     assert "| figure | run 1 | run 2 | median |" in text and "| 40.00 | 40.00 | 40.00 |" in text
     monkeypatch.setattr(benchmarking, "run_all", lambda quick=False: res)
     out, js = tmp_path / "r" / "ray_engine.md", tmp_path / "r.json"
-    assert benchmarking.main(quick=True, json_path=js, out_path=out, runs=2) == 0
+    assert benchmarking.run(quick=True, json_path=js, out_path=out, runs=2) == 0
     assert capsys.readouterr().out == out.read_text(encoding="utf-8") + "\n"  # printed and written
     assert json.loads(js.read_text())["runs"] == [figures, figures]
     assert not list(tmp_path.rglob("*.tmp"))

@@ -1,0 +1,279 @@
+"""The static part of the scene: every fixed object in one Open3D scene, and its culling.
+
+Static objects (motion :class:`raysim.motion.Stationary`) are transformed once
+to world coordinates and put together in ONE ``RaycastingScene``, in
+coordinates relative to ``offset_m`` (the mean of the objects' positions
+snapped to a 1024 m grid, so zero for a scene centred near the world origin)
+so that float32 keeps sub-millimetre precision at kilometre-scale
+coordinates; ray origins are shifted by the same offset, in float64, before
+casting.
+
+Culling: a table direction cell -> nearest static bounding sphere distance; a
+ray is cast only if that distance is below its sea range and its range limit.
+When a subsample shows that most rays would be cast anyway (a sensor
+surrounded by geometry), the table is skipped and all rays are cast.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Sequence
+
+import numpy as np
+import open3d as o3d
+
+from raysim.scene.geometry import (AZ_BINS, EL_BINS, bounding_sphere, direction_cells, face_against, intersect_sea,
+                                   sphere_cells)
+from raysim.scene.hits import NO_HIT, Hits, SceneObject
+from raysim.scene.rays import CHUNK, RayBatch, offset_tile, pack_rays, scratch, split_run
+
+STATIC_CULL_MAX_FRACTION = 0.5
+"""Cast all rays at the static scene when more than this fraction are candidates."""
+_SUBSAMPLE_RAYS = 2048
+"""Rays sampled to estimate the static candidate fraction."""
+_OFFSET_GRID_M = 1024.0
+"""The static scene's offset is snapped to this grid, metres."""
+
+
+@dataclass
+class StaticPart:
+    """All static objects in one Open3D scene (world frame shifted by ``offset_m``).
+
+    Built with :meth:`build`; ``nthreads`` is Embree's thread count (0 = all
+    cores) and ``workers`` the threads of the per-ray numpy work.
+    """
+
+    scene: o3d.t.geometry.RaycastingScene
+    offset_m: np.ndarray  # (3,) float64
+    offset_tile: np.ndarray | None  # offset pattern for pack_rays
+    geometry_object: np.ndarray  # (G,) int32: object id per geometry id
+    geometry_face_offset: np.ndarray  # (G,) int64: first face of each geometry in face_material
+    face_material: np.ndarray  # (F_total,) int16
+    geometry_object_ext: np.ndarray  # (G + 1,) geometry_object + [NO_HIT] (index -1 = miss)
+    geometry_face_offset_ext: np.ndarray  # (G + 1,) geometry_face_offset + [F_total + 1]
+    face_material_ext: np.ndarray  # (F_total + 1,) face_material + [-1]
+    sphere_centres: np.ndarray  # (G, 3) float64: world bounding sphere per object
+    sphere_radii: np.ndarray  # (G,) float64
+    nthreads: int = 0
+    workers: int = 1
+
+    @classmethod
+    def build(cls, objects: Sequence[SceneObject], nthreads: int, workers: int) -> "StaticPart":
+        """Put static objects, in world coordinates minus an offset, in one Open3D scene.
+
+        Parameters
+        ----------
+        objects : sequence of SceneObject
+            At least one static object (its pose is taken at t = 0).
+        nthreads : int
+            Embree threads (0 = all cores).
+        workers : int
+            Threads of the per-ray numpy work.
+
+        Returns
+        -------
+        StaticPart
+        """
+        poses = [o.motion.poses(np.zeros(1)) for o in objects]
+        mean = np.mean([p.position_m[0] for p in poses], axis=0)
+        offset = np.round(mean / _OFFSET_GRID_M) * _OFFSET_GRID_M
+        scene = o3d.t.geometry.RaycastingScene(nthreads=nthreads)
+        geometry_object, face_offset, materials, centres, radii = [], [], [], [], []
+        n_faces = 0
+        for obj, pose in zip(objects, poses):
+            world = np.asarray(obj.vertices_m, dtype=np.float64) @ pose.rotation()[0].T + pose.position_m[0]
+            gid = scene.add_triangles(
+                o3d.core.Tensor(np.ascontiguousarray(world - offset, dtype=np.float32)),
+                o3d.core.Tensor(np.ascontiguousarray(obj.faces, dtype=np.uint32)),
+            )
+            if gid != len(geometry_object):
+                raise RuntimeError(f"unexpected Open3D geometry id {gid}")
+            geometry_object.append(obj.object_id)
+            face_offset.append(n_faces)
+            materials.append(np.asarray(obj.face_material, dtype=np.int16))
+            n_faces += len(obj.faces)
+            c, r = bounding_sphere(world)
+            centres.append(c)
+            radii.append(r)
+        return cls(
+            scene=scene,
+            offset_m=offset,
+            offset_tile=offset_tile(offset),
+            geometry_object=np.array(geometry_object, dtype=np.int32),
+            geometry_face_offset=np.array(face_offset, dtype=np.int64),
+            face_material=np.concatenate(materials),
+            geometry_object_ext=np.array(geometry_object + [NO_HIT], dtype=np.int32),
+            geometry_face_offset_ext=np.array(face_offset + [n_faces + 1], dtype=np.int32),
+            face_material_ext=np.concatenate(materials + [np.array([-1], dtype=np.int16)]),
+            sphere_centres=np.array(centres),
+            sphere_radii=np.array(radii),
+            nthreads=nthreads,
+            workers=workers,
+        )
+
+    def near_table(self, batch: RayBatch) -> np.ndarray:
+        """Nearest distance at which a static object can be met through each direction cell.
+
+        Parameters
+        ----------
+        batch : RayBatch
+            With its origin box (``origin_centre``, ``spread_m``) set.
+
+        Returns
+        -------
+        (CELLS,) float32
+            Metres (rounded down); ``inf`` where no static object can be met.
+        """
+        st = self
+        table = np.full((AZ_BINS, EL_BINS), np.inf, dtype=np.float32)
+        cells = sphere_cells(st.sphere_centres, st.sphere_radii, batch.origin_centre, batch.spread_m)
+        near = np.nextafter((cells.near_m * (1 - 1e-6)).astype(np.float32), np.float32(-np.inf))  # round down
+        for k, lo, hi, e0, e1 in zip(*cells.runs(np.arange(len(near)))):
+            block = table[lo : hi + 1, e0 : e1 + 1]
+            np.minimum(block, near[k], out=block)
+        return table.reshape(-1)
+
+    def fraction(self, batch: RayBatch, near_table: np.ndarray, sea: bool) -> float:
+        """Fraction of the batch's rays the static table would keep (estimated on a subsample).
+
+        Parameters
+        ----------
+        batch : RayBatch
+        near_table : (CELLS,) float32
+            From :meth:`near_table`, metres.
+        sea : bool
+            Whether the sea stops the rays.
+
+        Returns
+        -------
+        float
+            In [0, 1].
+        """
+        step = max(1, batch.n // _SUBSAMPLE_RAYS)
+        sub = slice(0, batch.n, step)
+        d = batch.directions[sub]
+        cells = direction_cells(d[:, 0], d[:, 1], d[:, 2])
+        lim = np.full(cells.shape[0], np.inf)
+        if sea:
+            lim = intersect_sea(batch.origins[sub, 2], d[:, 2])
+        if batch.max_range is not None:
+            mr = batch.max_range[sub] if batch.max_range.ndim else float(batch.max_range)
+            lim = np.minimum(lim, mr)
+        return float(np.mean(near_table[cells] < lim))
+
+    def cast_all(self, batch: RayBatch) -> Hits:
+        """Cast all rays of a batch at the static scene.
+
+        Per-ray work: packing, one float32 -> float64 copy of ``t_hit``, one
+        comparison (plus three table look-ups when many rays hit); the rest
+        touches hits only. Open3D's own primitive and normal arrays are
+        returned as they are (-1 and zeros where no hit).
+
+        Parameters
+        ----------
+        batch : RayBatch
+            N rays (world frame, metres).
+
+        Returns
+        -------
+        Hits
+            N hits on the static objects (world-frame normals facing the rays).
+        """
+        st = self
+        n = batch.n
+        rays = scratch("rays", (n, 6))
+        pack_rays(batch.origins, batch.directions, st.offset_m, self.workers, out=rays)
+        res = st.scene.cast_rays(o3d.core.Tensor.from_numpy(rays), nthreads=self.nthreads)
+        t32 = res["t_hit"].numpy()
+        gid = res["geometry_ids"].numpy().view(np.int32)  # INVALID_ID -> -1
+        prim = res["primitive_ids"].numpy().view(np.int32)  # INVALID_ID -> -1
+        normal = res["primitive_normals"].numpy()  # zeros where no hit
+        rng = np.empty(n, dtype=np.float64)
+        obj = np.empty(n, dtype=np.int32)
+        material = np.empty(n, dtype=np.int16)
+        split_run(
+            n,
+            self.workers,
+            lambda a, b: _static_results_part(st, batch.directions, rays, t32, gid, prim, normal, rng, obj, material, a, b),
+        )
+        return Hits(rng, obj, normal, material, prim)
+
+    def merge_some(self, hits: Hits, batch: RayBatch, idx: np.ndarray) -> None:
+        """Cast rays ``idx`` at the static scene; keep hits nearer than the current ones (in place).
+
+        Parameters
+        ----------
+        hits : Hits
+            The batch's N current hits, updated in place.
+        batch : RayBatch
+        idx : (M,) int
+            Rays to cast.
+        """
+        st = self
+        if idx.size == 0:
+            return
+        rays = scratch("rays", (idx.size, 6))
+        pack_rays(batch.origins, batch.directions, st.offset_m, self.workers, out=rays, idx=idx)
+        res = st.scene.cast_rays(o3d.core.Tensor.from_numpy(rays), nthreads=self.nthreads)
+        t = res["t_hit"].numpy()
+        sel = np.flatnonzero(t < hits.range_m[idx])  # misses are inf
+        if sel.size == 0:
+            return
+        j = idx[sel]
+        g = res["geometry_ids"].numpy().view(np.int32)[sel]
+        prim = res["primitive_ids"].numpy().view(np.int32)[sel]
+        normal = res["primitive_normals"].numpy()[sel]
+        face_against(normal, np.arange(sel.size), np.take(batch.directions, j, axis=0))
+        hits.range_m[j] = t[sel]
+        hits.object_id[j] = st.geometry_object[g]
+        hits.primitive[j] = prim
+        hits.material[j] = st.face_material[st.geometry_face_offset[g] + prim]
+        hits.normal[j] = normal
+
+
+def _static_results_part(
+    st: StaticPart,
+    directions: np.ndarray,
+    rays: np.ndarray,
+    t32: np.ndarray,
+    gid: np.ndarray,
+    prim: np.ndarray,
+    normal: np.ndarray,
+    rng: np.ndarray,
+    obj: np.ndarray,
+    material: np.ndarray,
+    a: int,
+    b: int,
+) -> None:
+    """Turn Open3D's answers for rays ``a:b`` into ranges, ids, materials; flip normals.
+
+    Chunk by chunk (small temporaries stay in cache). A chunk with many hits is
+    handled with whole-chunk table look-ups (misses index the sentinels) and a
+    normal/direction dot product against the packed float32 rays; a chunk with
+    few hits is filled, then only its hits are touched.
+    """
+    for s in range(a, b, CHUNK):
+        e = min(b, s + CHUNK)
+        np.copyto(rng[s:e], t32[s:e])
+        g = gid[s:e]
+        if 16 * np.count_nonzero(g[::16] >= 0) > (e - s) // 8:  # many hits (a subsample decides)
+            np.take(st.geometry_object_ext, g, out=obj[s:e], mode="wrap")
+            face = np.take(st.geometry_face_offset_ext, g, mode="wrap")
+            face += prim[s:e]
+            np.take(st.face_material_ext, face, out=material[s:e], mode="wrap")
+            n_c, r_c = normal[s:e], rays[s:e]
+            dot = n_c[:, 0] * r_c[:, 3]  # 0 where no hit (zero normal)
+            dot += n_c[:, 1] * r_c[:, 4]
+            dot += n_c[:, 2] * r_c[:, 5]
+            flip = np.flatnonzero(dot > 0)
+            if flip.size:
+                n_c[flip] *= -1.0
+        else:
+            obj[s:e] = NO_HIT
+            material[s:e] = -1
+            hit = np.flatnonzero(g >= 0)
+            j = hit + s
+            gh = g[hit]
+            obj[j] = st.geometry_object[gh]
+            material[j] = st.face_material[st.geometry_face_offset[gh] + prim[j]]
+            face_against(normal, j, np.take(directions, j, axis=0))
