@@ -31,7 +31,7 @@ sys.path.insert(0, str(ROOT))
 from benchmarks.common import frozen_scene_rays_per_s, machine_line, peak_memory_mb, publish  # noqa: E402
 from raysim import render as render_module  # noqa: E402
 from raysim.scenario import load_scenario, with_overrides  # noqa: E402
-from raysim.sensors import hdl32e  # noqa: E402
+from groundfloor import hdl32e  # noqa: E402
 from raysim.sensors.lidar import LidarRenderer  # noqa: E402
 from raysim.world import World  # noqa: E402
 

@@ -18,12 +18,13 @@ from typing import Callable
 import numpy as np
 from tqdm import tqdm
 
+from groundfloor.recording import FORMAT, FORMAT_VERSION, MANIFEST
 from raysim import __version__, schema
 from raysim.pose import heading_deg_from_yaw
 from raysim.progress import bars as progress_bars
 from raysim.progress import stage
 from raysim.recording.jsonl import course_and_speed, write_ownship_chunk, write_truth_chunk
-from raysim.recording.staging import MANIFEST, StagedDirectory, atomic_path
+from raysim.recording.staging import StagedDirectory, atomic_path
 from raysim.scenario import Scenario, scenario_to_yaml
 from raysim.world import World
 
@@ -292,8 +293,8 @@ def render(scenario: Scenario, out_dir: Path, progress: bool | None = None, form
             rendered.append(name)
         def manifest_now() -> dict:
             return {
-                "format": "raysim-recording",
-                "format_version": 1,
+                "format": FORMAT,
+                "format_version": FORMAT_VERSION,
                 "scenario": scenario.name,
                 "seed": scenario.seed,
                 "start_time": schema.to_plain(scenario.start_time),

@@ -48,10 +48,8 @@ from raysim.scenario_format import (  # noqa: F401 (the format's classes, import
     WaveMotion,
 )
 from raysim.schema import Context
+from raysim.sea import DOUGLAS_WAVE_HEIGHT_M  # noqa: F401 (sea physics: raysim.sea; importable here as before)
 from raysim.yaml_loader import read_yaml  # noqa: F401 (raysim.hilsim reads the thesis's files with it)
-
-#: Douglas sea state -> significant wave height upper bound, m (WMO sea state code 3700).
-DOUGLAS_WAVE_HEIGHT_M = (0.0, 0.1, 0.5, 1.25, 2.5, 4.0, 6.0)
 
 #: Own-ship wave motion defaults per Douglas sea state 0..6 for a ~11 m craft
 #: (engineering defaults, unverified; override with own_ship.motion).

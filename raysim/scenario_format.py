@@ -261,7 +261,7 @@ def _ais_text(limit: int):
     """Check of an AIS text field: the 6-bit character set and at most ``limit`` characters."""
 
     def check(value: str) -> str | None:
-        from raysim.sensors.ais_fields import AIS_CHARS
+        from raysim.ais_fields import AIS_CHARS
 
         bad = sorted({c for c in value.upper() if c not in AIS_CHARS})
         if bad:

@@ -17,6 +17,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.special import ndtri
 
+#: Douglas sea state -> significant wave height upper bound, m (WMO sea state code 3700).
+DOUGLAS_WAVE_HEIGHT_M = (0.0, 0.1, 0.5, 1.25, 2.5, 4.0, 6.0)
 #: Wind speed typical of each Douglas sea state 0..6, m/s (Beaufort-Douglas correspondence,
 #: mid-band values; unverified engineering table).
 SEA_STATE_WIND_MPS = (0.0, 2.0, 4.5, 7.0, 9.5, 12.5, 16.0)

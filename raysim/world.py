@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from groundfloor.units import KNOT_MPS  # noqa: F401 (raysim.world.KNOT_MPS)
 from raysim import meshes
 from raysim.errors import InputError
 from raysim.geodesy import LocalFrame
@@ -23,7 +24,6 @@ from raysim.random_streams import stream
 from raysim.scenario import Scenario, ShipAis, WaveMotion as WaveMotionConfig
 from raysim.trajectory_csv import read_trajectory_csv
 
-KNOT_MPS = 1852.0 / 3600.0  # docs/reference.md section 1
 
 
 @dataclass(frozen=True)

@@ -9,92 +9,20 @@ was made.
 Body frame (REP-103): x forward, y left, z up. Angles read from the recording are
 marine degrees (heading clockwise from north, roll starboard down positive, pitch
 bow up positive) and are turned into the FLU rotation ``Rz(yaw) Ry(pitch) Rx(roll)``
-here, with ``yaw = 90 deg - heading`` and FLU pitch = -(marine pitch).
+here, with ``yaw = 90 deg - heading`` and FLU pitch = -(marine pitch). The frame, the rotations and
+the mounts are :mod:`groundfloor.frames`, shared with raysim.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from functools import lru_cache
-
 import numpy as np
-from pyproj import Transformer
 
+from groundfloor.frames import LocalFrame, Mount, marine_rotation, rotation_matrices  # noqa: F401 (tdm's names)
 
-@lru_cache(maxsize=16)
-def _transformers(lat0: float, lon0: float) -> tuple[Transformer, Transformer]:
-    proj = f"+proj=tmerc +lat_0={lat0!r} +lon_0={lon0!r} +k=1 +x_0=0 +y_0=0 +ellps=WGS84 +units=m +no_defs"
-    return (Transformer.from_crs("EPSG:4326", proj, always_xy=True),
-            Transformer.from_crs(proj, "EPSG:4326", always_xy=True))
+__all__ = ["EnuFrame", "Mount", "OwnshipTrack", "marine_rotation", "rotation_matrices"]
 
-
-class EnuFrame:
-    """Local ENU metres about an origin (lat0, lon0 in degrees, WGS84)."""
-
-    def __init__(self, lat0_deg: float, lon0_deg: float):
-        self.lat0_deg, self.lon0_deg = float(lat0_deg), float(lon0_deg)
-        self._forward, self._inverse = _transformers(self.lat0_deg, self.lon0_deg)
-
-    def to_enu(self, lat_deg, lon_deg) -> tuple[np.ndarray, np.ndarray]:
-        """(east, north) in metres, arrays of the inputs' shape."""
-        x, y = self._forward.transform(np.asarray(lon_deg, dtype=float), np.asarray(lat_deg, dtype=float))
-        return np.asarray(x, dtype=float), np.asarray(y, dtype=float)
-
-    def to_geodetic(self, east_m, north_m) -> tuple[np.ndarray, np.ndarray]:
-        """(lat, lon) in degrees from ENU metres."""
-        lon, lat = self._inverse.transform(np.asarray(east_m, dtype=float), np.asarray(north_m, dtype=float))
-        return np.asarray(lat, dtype=float), np.asarray(lon, dtype=float)
-
-
-def rotation_matrices(yaw_rad, pitch_rad, roll_rad) -> np.ndarray:
-    """(N, 3, 3) body-to-ENU rotations ``Rz(yaw) @ Ry(pitch) @ Rx(roll)`` (FLU angles, radians)."""
-    cy, sy = np.cos(yaw_rad), np.sin(yaw_rad)
-    cp, sp = np.cos(pitch_rad), np.sin(pitch_rad)
-    cr, sr = np.cos(roll_rad), np.sin(roll_rad)
-    cy, sy, cp, sp, cr, sr = np.broadcast_arrays(cy, sy, cp, sp, cr, sr)
-    r = np.empty(cy.shape + (3, 3))
-    r[..., 0, 0] = cy * cp
-    r[..., 0, 1] = cy * sp * sr - sy * cr
-    r[..., 0, 2] = cy * sp * cr + sy * sr
-    r[..., 1, 0] = sy * cp
-    r[..., 1, 1] = sy * sp * sr + cy * cr
-    r[..., 1, 2] = sy * sp * cr - cy * sr
-    r[..., 2, 0] = -sp
-    r[..., 2, 1] = cp * sr
-    r[..., 2, 2] = cp * cr
-    return r
-
-
-def marine_rotation(heading_deg, pitch_deg, roll_deg) -> np.ndarray:
-    """(N, 3, 3) body-to-ENU rotations from marine angles in degrees (module docstring)."""
-    return rotation_matrices(np.radians(90.0 - np.asarray(heading_deg, dtype=float)),
-                             -np.radians(np.asarray(pitch_deg, dtype=float)),
-                             np.radians(np.asarray(roll_deg, dtype=float)))
-
-
-@dataclass(frozen=True)
-class Mount:
-    """A sensor's mounting on the own ship (body frame; marine angles, yaw clockwise from the bow)."""
-
-    x_m: float = 0.0
-    y_m: float = 0.0
-    z_m: float = 0.0
-    roll_deg: float = 0.0
-    pitch_deg: float = 0.0
-    yaw_deg: float = 0.0
-
-    @classmethod
-    def from_dict(cls, d: dict | None) -> "Mount":
-        d = d or {}
-        return cls(**{k: float(d.get(k, 0.0)) for k in ("x_m", "y_m", "z_m", "roll_deg", "pitch_deg", "yaw_deg")})
-
-    def rotation(self) -> np.ndarray:
-        """(3, 3) sensor-to-body rotation."""
-        return rotation_matrices(np.radians(-self.yaw_deg), -np.radians(self.pitch_deg), np.radians(self.roll_deg))
-
-    def translation_m(self) -> np.ndarray:
-        """(3,) sensor origin in the body frame, metres."""
-        return np.array([self.x_m, self.y_m, self.z_m])
+#: Local ENU metres about an origin (lat0, lon0 in degrees, WGS84): ``to_enu``, ``to_geodetic``.
+EnuFrame = LocalFrame
 
 
 class OwnshipTrack:

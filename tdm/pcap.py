@@ -50,6 +50,10 @@ from pathlib import Path
 
 import numpy as np
 
+from groundfloor.hdl32e import (BLOCK_FLAG, BLOCKS_PER_PACKET, CENTIDEG_PER_TURN, COS_AZIMUTH_STEP, COS_ELEVATION,
+                                CYCLE_DT_NS, DATA_PORT, DISTANCE_UNIT_M, ELEVATION_DEG, FIRING_DT_NS,
+                                PACKET_BYTES, PACKET_DTYPE, POSITION_PORT, PRODUCT_IDS_ACCEPTED, RETURN_MODE_DUAL, RING,
+                                SIN_AZIMUTH_STEP, SIN_ELEVATION, Z_OFFSET_M, firing_azimuths_centideg)
 from tdm.detections import ReadStats
 from tdm.errors import RecordingError
 from tdm.recording.files import regular_file
@@ -59,49 +63,10 @@ __all__ = ["iter_pcap_sweeps", "check_pcap_header", "decode_packets", "firing_az
            "Z_OFFSET_M", "RING"]
 
 # ----------------------------------------------------------------------------- HDL-32E facts
-# docs/reference.md section 2 (HDL-32E manual 63-9113; ros-drivers/velodyne 32db.yaml;
-# valgur/velodyne_decoder calib_db.cpp, packet_decoder.cpp).
-
-#: Elevation of each laser in DSR (firing / packet slot) order, degrees.
-ELEVATION_DEG = np.array([
-    -30.67, -9.33, -29.33, -8.00, -28.00, -6.67, -26.67, -5.33, -25.33, -4.00, -24.00, -2.67, -22.67, -1.33, -21.33, 0.00,
-    -20.00, 1.33, -18.67, 2.67, -17.33, 4.00, -16.00, 5.33, -14.67, 6.67, -13.33, 8.00, -12.00, 9.33, -10.67, 10.67,
-])
-#: Height of each laser's origin above the sensor origin in DSR order, metres (decoders add it to z).
-Z_OFFSET_M = 1e-3 * np.array([
-    17.17, 4.76, 16.27, 4.07, 15.40, 3.38, 14.54, 2.70, 13.71, 2.02, 12.89, 1.35, 12.09, 0.67, 11.31, 0.00,
-    10.54, -0.67, 9.78, -1.35, 9.04, -2.02, 8.30, -2.70, 7.58, -3.38, 6.86, -4.07, 6.15, -4.76, 5.45, -5.45,
-])
-#: Ring of each DSR slot: rank of the laser by elevation, 0 = lowest.
-RING = np.argsort(np.argsort(ELEVATION_DEG, kind="stable"), kind="stable").astype(np.uint8)
-N_LASERS = 32
-BLOCKS_PER_PACKET = 12
-FIRING_DT_S = 1.152e-6  # one laser every 1.152 us
-CYCLE_DT_S = 46.08e-6  # 32 firings + 9.216 us recharge
-FIRING_DT_NS = 1152  # the same in integer nanoseconds (exact)
-CYCLE_DT_NS = 46080
-DISTANCE_UNIT_M = 0.002  # 2 mm units, 0 = no return
-PACKET_BYTES = 1206  # UDP payload of a data packet
-BLOCK_FLAG = 0xEEFF  # bytes FF EE read little-endian
-DATA_PORT = 2368
-POSITION_PORT = 8308
-RETURN_MODE_DUAL = 0x39  # byte 1204: 0x37 strongest, 0x38 last, 0x39 dual
-#: Product id byte (1205) of the HDL-32E; 0x00 is accepted too (firmware that leaves it blank) (unverified).
-PRODUCT_IDS_ACCEPTED = (0x21, 0x00)
-CENTIDEG_PER_TURN = 36000
-
-#: cos/sin of the 36000 encoder steps and of the 32 elevations (the decoders' lookup tables)
-_COS_AZ = np.cos(np.radians(np.arange(CENTIDEG_PER_TURN) * 0.01))
-_SIN_AZ = np.sin(np.radians(np.arange(CENTIDEG_PER_TURN) * 0.01))
-_COS_EL = np.cos(np.radians(ELEVATION_DEG))
-_SIN_EL = np.sin(np.radians(ELEVATION_DEG))
-
-PACKET_DTYPE = np.dtype([
-    ("blocks", np.dtype([("flag", "<u2"), ("azimuth", "<u2"),
-                         ("returns", np.dtype([("distance", "<u2"), ("reflectivity", "u1")]), (N_LASERS,))]),
-     (BLOCKS_PER_PACKET,)),
-    ("timestamp", "<u4"), ("return_mode", "u1"), ("product_id", "u1")])
-assert PACKET_DTYPE.itemsize == PACKET_BYTES
+# groundfloor.hdl32e (docs/reference.md section 2), the same facts raysim's writer uses; the
+# decoders' cos/sin tables of the 36000 encoder steps and of the 32 elevations.
+_COS_AZ, _SIN_AZ = COS_AZIMUTH_STEP, SIN_AZIMUTH_STEP
+_COS_EL, _SIN_EL = COS_ELEVATION, SIN_ELEVATION
 
 # ----------------------------------------------------------------------------- PCAP facts
 # libpcap file format (tcpdump.org "pcap-savefile(5)", IETF draft-ietf-opsawg-pcap).
@@ -337,44 +302,6 @@ def _udp_payloads(records: np.ndarray, fmt: _Format, stats: ReadStats) -> tuple[
 
 
 # ----------------------------------------------------------------------------- packets to points
-
-
-def firing_azimuths_centideg(block_az: np.ndarray, dual: np.ndarray) -> np.ndarray:
-    """Azimuth of every firing slot as velodyne_decoder computes it from the block azimuths.
-
-    The rotation rate of a packet is ``wrap(az[11] - az[0]) / (t[11] - t[0])`` and firing ``j`` of
-    a block lies at ``wrap(lround(block_az + rate * (t_j - t_0)))``, all in float32
-    (velodyne_decoder ``unpack_16_32_beam``; docs/reference.md section 2).
-
-    Parameters
-    ----------
-    block_az : (P, 12) uint16
-        Block azimuths, 0.01 deg.
-    dual : (P,) bool
-        Dual-return packets (6 firing cycles, blocks in pairs with the same azimuth).
-
-    Returns
-    -------
-    (P, 12, 32) int64
-        Azimuth of every firing slot, 0.01 deg, in 0..35999.
-    """
-    az = block_az.astype(np.int64)
-    diff = np.mod(az[:, -1] - az[:, 0], CENTIDEG_PER_TURN).astype(np.float32)
-    cycles_single = np.arange(BLOCKS_PER_PACKET, dtype=np.float64)
-    cycles_dual = cycles_single // 2
-    out = np.empty(block_az.shape + (N_LASERS,), dtype=np.int64)
-    for is_dual, cycles in ((False, cycles_single), (True, cycles_dual)):
-        rows = np.flatnonzero(dual == is_dual)
-        if rows.size == 0:
-            continue
-        duration = np.float32(CYCLE_DT_S * cycles[-1])
-        rate = diff[rows] / duration  # (R,) float32, 0.01 deg per s
-        table = (CYCLE_DT_S * cycles[:, None] + FIRING_DT_S * np.arange(N_LASERS)[None, :]).astype(np.float32)
-        dt = (table - table[:, :1]).astype(np.float32)  # (12, 32) s since the block's first firing
-        value = block_az[rows].astype(np.float32)[:, :, None] + rate[:, None, None] * dt[None, :, :]
-        value = value.astype(np.float32) + np.float32(CENTIDEG_PER_TURN)
-        out[rows] = np.floor(value.astype(np.float64) + 0.5).astype(np.int64) % CENTIDEG_PER_TURN  # lround (> 0)
-    return out
 
 
 def decode_packets(payloads: np.ndarray, capture_ns: np.ndarray, start_ns: int,

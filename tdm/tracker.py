@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from groundfloor.units import KNOT_MPS
 from tdm import ekf
 from tdm.association import chi2_gate, gnn, mahalanobis2
 from tdm.detections import AisReport, AisStatic, Detections
@@ -316,7 +317,6 @@ class AisTrackerConfig:
     process: ekf.ProcessNoise = field(default_factory=ekf.ProcessNoise)
 
 
-KNOT_MPS = 1852.0 / 3600.0
 #: Prior variances of an AIS track's states that its first report does not measure: position
 #: (always measured), course pi^2 (unknown), speed (5 m/s)^2, turn rate (3 deg/s)^2, cross-section
 #: (1000 m^2)^2.

@@ -95,7 +95,7 @@ def mast_view(world: World, scene: Scene, t_s: float, size=(1280, 480), fov_deg:
 
 def lidar_sweep_view(world: World, t_s: float, size_px: int = 900, span_m: float = 100.0) -> Image.Image:
     """One HDL-32E revolution starting at t, bird's-eye in the sensor frame, coloured by intensity."""
-    from raysim.sensors import hdl32e
+    from groundfloor import hdl32e
     from raysim.sensors.carrier import CarrierScene
     from raysim.sensors.lidar import LidarRenderer
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import datetime as dt
 from functools import reduce
 
-KNOTS_PER_MPS = 3600.0 / 1852.0
+from groundfloor.units import KNOTS_PER_MPS
 
 
 def checksum(body: str) -> str:

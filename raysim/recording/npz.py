@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from groundfloor.recording import SweepSchema, sweep_file_name
 from raysim.recording.staging import atomic_path
 
 _EPOCH = (1980, 1, 1, 0, 0, 0)
@@ -27,3 +28,12 @@ def write_npz(path: Path, arrays: dict[str, np.ndarray]) -> None:
             info = zipfile.ZipInfo(f"{name}.npy", date_time=_EPOCH)
             info.external_attr = 0o644 << 16
             archive.writestr(info, buffer.getvalue())
+
+
+def write_sweep(sweeps_dir: Path, number: int, schema: SweepSchema, arrays: dict[str, np.ndarray]) -> None:
+    """Write sweep ``number`` as ``sweeps_dir/NNNNNN.npz``, its arrays held to the recording contract.
+
+    The names, dtypes and dimensions are :mod:`groundfloor.recording`'s (``schema.conform``: a
+    breach is a ``ValueError``, a writer's bug), the contract the TDM's readers check by.
+    """
+    write_npz(Path(sweeps_dir) / sweep_file_name(number), schema.conform(arrays))

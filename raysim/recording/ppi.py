@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
+from groundfloor.units import METRES_PER_NM
 from raysim.recording.staging import atomic_path
 
 SIZE_PX = 800
@@ -25,7 +26,6 @@ SIZE_PX = 800
 #: phosphor green: video level 0..15 -> RGB
 PALETTE = np.array([[40 * v, 40 + 215 * v, 20 + 60 * v] for v in np.arange(16) / 15.0]).astype(np.uint8)
 BEARING_BINS = 7200  # 0.05 deg: finer than the finest spoke spacing drawn (8192 spokes: 0.044 deg ~ one bin)
-METRES_PER_NM = 1852.0
 FONT_PX = 13  # Pillow's bundled font (the same glyphs everywhere: the pictures stay byte-identical)
 TEXT = (170, 215, 170)
 LINE_PX = 16

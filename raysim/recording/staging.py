@@ -1,4 +1,4 @@
-"""Output directories that appear whole or not at all.
+"""raysim's output directories: a recording appears whole or not at all.
 
 A run writes into a hidden staging directory next to the requested one
 (``.NAME.partial-PID``); :meth:`StagedDirectory.commit` swaps it into place at
@@ -6,168 +6,21 @@ the end. On any error or interrupt the staging directory is removed, so bad
 input or a failed run leaves nothing behind. Inside the staging directory each
 file is itself written under a temporary name and renamed (:func:`atomic_path`).
 
-Faults (docs/contracts.md "Command line"):
-
-- a full disk, an exceeded quota, a read-only file system or an I/O error while writing
-  (:data:`WRITE_ERRNOS`) leaves the staging directory as :class:`OutputWriteError`, an ``OSError``
-  that names the output directory; the CLI prints ``error: <directory>: writing: <what>``;
-- SIGTERM raises :class:`Terminated` (a ``KeyboardInterrupt``) while :func:`sigterm_as_interrupt`
-  is active, so a terminated run cleans up exactly as one interrupted by Ctrl-C;
-- the staging directories of killed runs (``.NAME.partial-PID``, and ``.NAME.old-PID`` of a
-  replacement cut short) are removed by the next run into the same parent directory, but only
-  when process PID is gone (:func:`remove_stale`).
+The machinery (write faults, SIGTERM as an interrupt, stale staging directories of killed runs)
+is :mod:`groundfloor.staging`, shared with the TDM; it is re-exported here.
 """
 
 from __future__ import annotations
 
-import errno
 import os
-import re
 import shutil
-import signal
-import socket
-import threading
-from contextlib import contextmanager
 from pathlib import Path
-from typing import Iterator
 
+from groundfloor.recording import MANIFEST
+from groundfloor.staging import (EXIT_INTERRUPTED, EXIT_TERMINATED, HOST_MARKER, WRITE_ERRNOS, OutputWriteError,  # noqa: F401
+                                 Sigterm, Staging, Terminated, atomic_path, is_write_fault, remove_stale,
+                                 sigterm_as_interrupt, write_fault)
 from raysim.errors import InputError
-
-MANIFEST = "manifest.json"
-
-#: ``errno`` values that mean "the output cannot be written" (not a bug, not bad input): no space
-#: left on the device, disk quota exceeded, read-only file system, I/O error, file too large (a
-#: file-size limit, ``ulimit -f``).
-WRITE_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EIO, errno.EFBIG})
-
-#: Inside a staging directory: the host that owns it (removed before the directory is committed).
-#: A stale-looking directory made on another host sharing the file system (``raysim batch`` on a
-#: Dask cluster) is never removed: its PID cannot be checked from here.
-HOST_MARKER = ".staging-host"
-
-_STAGING_NAME = re.compile(r"^\..+\.(?:partial|old)-(\d+)$")
-
-
-class OutputWriteError(OSError):
-    """Writing the output directory ``filename`` failed with ``errno`` (one of :data:`WRITE_ERRNOS`).
-
-    Built as ``OutputWriteError(errno, strerror, directory)`` so that it pickles (Dask) and stays an
-    ``OSError`` with the original ``errno`` for the layers above.
-    """
-
-    @property
-    def directory(self) -> str:
-        """The output directory that could not be written."""
-        return str(self.filename)
-
-    @property
-    def what(self) -> str:
-        """``no space left on device``, ``disk quota exceeded``, ...: the system's text, lower case."""
-        text = self.strerror or os.strerror(self.errno)
-        return text[:1].lower() + text[1:]
-
-
-def is_write_fault(exc: BaseException) -> bool:
-    """Whether ``exc`` is an ``OSError`` whose ``errno`` is in :data:`WRITE_ERRNOS`."""
-    return isinstance(exc, OSError) and exc.errno in WRITE_ERRNOS
-
-
-def write_fault(exc: OSError, directory: Path) -> OutputWriteError:
-    """``exc`` as an :class:`OutputWriteError` naming ``directory`` (the outermost output directory wins)."""
-    return OutputWriteError(exc.errno, exc.strerror or os.strerror(exc.errno), str(directory))
-
-
-#: Exit codes of a command stopped by a signal: 128 + the signal's number, as a shell reports it.
-EXIT_INTERRUPTED = 128 + signal.SIGINT  # 130, Ctrl-C
-EXIT_TERMINATED = 128 + signal.SIGTERM  # 143
-
-
-class Terminated(KeyboardInterrupt):
-    """SIGTERM received: raised in the main thread like Ctrl-C's ``KeyboardInterrupt`` (same cleanup)."""
-
-
-class Sigterm:
-    """What :func:`sigterm_as_interrupt` yields: ``received`` is True once SIGTERM arrived.
-
-    The :class:`Terminated` it raises can come out of a C extension as another exception (an
-    ``ImportError`` when it lands in a module's initialisation): a command that fails after
-    ``received`` was set was terminated, whatever the exception says.
-    """
-
-    def __init__(self) -> None:
-        self.received = False
-
-
-@contextmanager
-def sigterm_as_interrupt() -> Iterator[Sigterm]:
-    """While inside, SIGTERM raises :class:`Terminated` in this process's main thread.
-
-    A second SIGTERM is ignored, so the cleanup the first one started runs to its end (SIGKILL
-    still stops the process). Worker processes forked meanwhile inherit the handler; in them
-    SIGTERM keeps its default action (the process ends). Outside the main thread nothing changes.
-    """
-    state = Sigterm()
-    if threading.current_thread() is not threading.main_thread():
-        yield state
-        return
-    owner = os.getpid()
-
-    def handler(signum, frame):
-        if os.getpid() != owner:  # a forked worker: end as SIGTERM ends it by default
-            signal.signal(signum, signal.SIG_DFL)
-            os.kill(os.getpid(), signum)
-            return
-        signal.signal(signum, signal.SIG_IGN)
-        state.received = True
-        raise Terminated()
-
-    previous = signal.signal(signal.SIGTERM, handler)
-    try:
-        yield state
-    finally:
-        signal.signal(signal.SIGTERM, previous)
-
-
-def _pid_alive(pid: int) -> bool:
-    """Whether a process ``pid`` exists here (another user's, or another program's, counts as alive)."""
-    if pid <= 0:
-        return True  # 0 and negative numbers address process groups: never treat as gone
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except (PermissionError, OverflowError):
-        return True
-    return True
-
-
-def remove_stale(parent: Path) -> list[Path]:
-    """Remove the staging directories of killed runs in ``parent``; returns those removed.
-
-    A directory named ``.NAME.partial-PID`` or ``.NAME.old-PID`` is stale when no process PID
-    exists on this host (``os.kill(PID, 0)`` raises ``ProcessLookupError``). Kept: a live PID (even
-    if it now belongs to another program: conservative), and a directory whose
-    :data:`HOST_MARKER` names another host.
-    """
-    removed = []
-    try:
-        entries = list(Path(parent).iterdir())
-    except OSError:
-        return removed
-    host = socket.gethostname()
-    for entry in sorted(entries):
-        match = _STAGING_NAME.match(entry.name)
-        if match is None or entry.is_symlink() or not entry.is_dir():
-            continue
-        try:
-            owner = (entry / HOST_MARKER).read_text(encoding="utf-8").strip()
-        except (OSError, UnicodeDecodeError):
-            owner = host  # no marker: an .old directory, or one made before markers
-        if owner != host or _pid_alive(int(match.group(1))):
-            continue
-        shutil.rmtree(entry, ignore_errors=True)
-        removed.append(entry)
-    return removed
 
 
 def check_output_dir(path: Path) -> None:
@@ -178,39 +31,18 @@ def check_output_dir(path: Path) -> None:
         raise InputError("command line", "-o", f"{path} is not empty and holds no raysim recording (no {MANIFEST}); choose another directory")
 
 
-class StagedDirectory:
+class StagedDirectory(Staging):
     """A directory built under a temporary name and moved into place by :meth:`commit`.
 
     Use as a context manager: leaving it by an exception removes everything; a write fault
-    (:data:`WRITE_ERRNOS`) leaves it as :class:`OutputWriteError` naming ``final``. Entering removes
+    (:data:`WRITE_ERRNOS`) leaves it as :class:`OutputWriteError` naming ``final``. Entering refuses
+    an output directory that is neither empty nor a recording (:func:`check_output_dir`) and removes
     the stale staging directories of killed runs beside ``final`` (:func:`remove_stale`).
     """
 
-    def __init__(self, final: Path):
-        self.final = Path(final).absolute()
-        self.path = self.final.parent / f".{self.final.name}.partial-{os.getpid()}"
-        self._committed = False
-
     def __enter__(self) -> "StagedDirectory":
         check_output_dir(self.final)
-        try:
-            self.final.parent.mkdir(parents=True, exist_ok=True)
-            remove_stale(self.final.parent)
-            shutil.rmtree(self.path, ignore_errors=True)
-            self.path.mkdir()
-            (self.path / HOST_MARKER).write_text(socket.gethostname() + "\n", encoding="utf-8")
-        except OSError as exc:
-            shutil.rmtree(self.path, ignore_errors=True)
-            if is_write_fault(exc):
-                raise write_fault(exc, self.final) from exc
-            raise
-        return self
-
-    def __exit__(self, exc_type, exc, tb) -> None:
-        if not self._committed:
-            shutil.rmtree(self.path, ignore_errors=True)
-        if exc is not None and is_write_fault(exc):
-            raise write_fault(exc, self.final) from exc
+        return super().__enter__()
 
     def commit(self) -> None:
         """Replace the final directory (an older recording, or nothing) by the staged one."""
@@ -223,17 +55,3 @@ class StagedDirectory:
         self._committed = True
         if old is not None:
             shutil.rmtree(old, ignore_errors=True)
-
-
-@contextmanager
-def atomic_path(path: Path) -> Iterator[Path]:
-    """Yield a temporary sibling path to write; rename it to ``path`` on success, delete it on failure."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp")
-    try:
-        yield tmp
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise

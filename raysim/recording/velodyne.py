@@ -16,15 +16,8 @@ from typing import BinaryIO
 
 import numpy as np
 
-from raysim.sensors.hdl32e import BLOCKS_PER_PACKET, DATA_PORT, N_LASERS, PACKET_BYTES, POSITION_PORT, PRODUCT_ID
-
-BLOCK_DTYPE = np.dtype([("flag", "<u2"), ("azimuth", "<u2"),
-                        ("returns", np.dtype([("distance", "<u2"), ("reflectivity", "u1")]), (N_LASERS,))])
-PACKET_DTYPE = np.dtype([("blocks", BLOCK_DTYPE, (BLOCKS_PER_PACKET,)), ("timestamp", "<u4"),
-                         ("return_mode", "u1"), ("product_id", "u1")])
-assert PACKET_DTYPE.itemsize == PACKET_BYTES
-BLOCK_FLAG = 0xEEFF  # bytes FF EE, little-endian
-POSITION_PACKET_BYTES = 512
+from groundfloor.hdl32e import (BLOCK_DTYPE, BLOCK_FLAG, DATA_PORT, PACKET_BYTES, PACKET_DTYPE,  # noqa: F401
+                                POSITION_PACKET_BYTES, POSITION_PORT, PRODUCT_ID)
 
 SENSOR_IP = bytes([192, 168, 1, 201])  # the HDL-32E's factory address
 BROADCAST_IP = bytes([255, 255, 255, 255])

@@ -36,17 +36,18 @@ import numpy as np
 from scipy.ndimage import gaussian_filter1d, uniform_filter1d
 from scipy.signal import lfilter
 
+from groundfloor.frames import mount_transform
+from groundfloor.recording import RADAR_SWEEP
 from raysim.materials import material_table
 from raysim.pose import heading_deg_from_yaw
 from raysim.random_streams import stream
-from raysim.recording.npz import write_npz
+from raysim.recording.npz import write_sweep
 from raysim.recording.ppi import PpiLabels, write_ppi
 from raysim.scene import NO_HIT, SEA_ID
 from raysim.sensors import radar_physics as phys
 from raysim.sensors.carrier import CarrierScene
 from raysim.sensors.radar_facets import FacetTable
 from raysim.sensors.radar_texture import SeaTexture
-from raysim.sensors.lidar import mount_transform
 
 
 #: mean of 10 log10 of exponential noise power of mean 1: -10 gamma / ln 10 (Euler's gamma), dB
@@ -436,7 +437,7 @@ class RadarRenderer:
         for rev in (progress(revs) if progress else revs):
             started = time.perf_counter()
             out = self.revolution(rev)
-            write_npz(sweeps_dir / f"{rev:06d}.npz", out.arrays())
+            write_sweep(sweeps_dir, rev, RADAR_SWEEP, out.arrays())
             write_ppi(ppi_dir / f"{rev:06d}.png", out.arrays(), PpiLabels.from_scenario(self.world.scenario))
             counts["sweeps"] += 1
             counts["spokes"] += self.spokes

@@ -15,7 +15,7 @@ import math
 import numpy as np
 from scipy.special import gammaincinv, ndtr
 
-from raysim.scenario import DOUGLAS_WAVE_HEIGHT_M
+from raysim.sea import DOUGLAS_WAVE_HEIGHT_M
 
 # ------------------------------------------------------------------ constants
 
@@ -304,7 +304,7 @@ def flat_plate_rcs_m2(area_m2: float, f_ghz: float = FREQUENCY_GHZ) -> float:
 # ------------------------------------------------------------------ multipath (REF 3.5)
 
 # Significant wave height of each Douglas sea state 0..6, m: the middle of its WMO code 3700 band
-# (raysim.scenario.DOUGLAS_WAVE_HEIGHT_M holds the bands' upper bounds); rms surface height = Hs / 4.
+# (raysim.sea.DOUGLAS_WAVE_HEIGHT_M holds the bands' upper bounds); rms surface height = Hs / 4.
 SEA_STATE_HS_M = tuple((lo + hi) / 2.0 for lo, hi in zip((0.0,) + DOUGLAS_WAVE_HEIGHT_M[:-1], DOUGLAS_WAVE_HEIGHT_M))
 
 

@@ -44,12 +44,12 @@ from pyais import NMEAMessage, bit_vector
 from pyais.exceptions import AISBaseException, UnknownMessageException
 from pyais.messages import NMEASentenceFactory
 
+from groundfloor.units import MPS_PER_KNOT  # docs/reference.md section 1
 from tdm.detections import AisReport, AisStatic, ReadStats
 from tdm.frames import EnuFrame
 
 __all__ = ["read_ais", "rot_deg_per_min", "MPS_PER_KNOT"]
 
-MPS_PER_KNOT = 1852.0 / 3600.0  # docs/reference.md section 1
 ROT_SCALE = 4.733  # ITU-R M.1371 ROT indicator: k = 4.733 sqrt(ROT deg/min) (docs/reference.md section 4)
 ROT_NOT_AVAILABLE = -128
 ROT_NO_INDICATOR = 127  # +-127: turning at more than 5 deg / 30 s, no turn indicator

@@ -1,7 +1,8 @@
 """Reading a recording: one contract, file by file (docs/formats.md, "Reading a recording: warnings and errors").
 
 Every file the TDM reads goes through a module of this package, which checks it against the
-recording's format and decides, for each defect, between
+recording's format (its names, sweep arrays and dtypes: :mod:`groundfloor.recording`, the contract
+raysim writes by) and decides, for each defect, between
 
 * a *warning*: what a real logger leaves (a cut last line, a sweep file cut short by a crash, a
   missing sweep number, a truncated PCAP record, a packet out of time, a bad NMEA line), counted
@@ -17,6 +18,8 @@ Modules, one job each:
 - :mod:`~tdm.recording.files`: a readable regular file is there (not a directory, a loop, ...);
 - :mod:`~tdm.recording.manifest`: ``manifest.json``;
 - :mod:`~tdm.recording.scenario`: ``scenario.yaml``, the values the TDM uses;
+- :mod:`~tdm.recording.description`: the two as a typed :class:`groundfloor.recording.RecordingDescription`
+  (start time, duration, periods, ranges, mounts);
 - :mod:`~tdm.recording.jsonl`: JSON-lines files, line by line;
 - :mod:`~tdm.recording.ownship`: ``ownship.jsonl`` as checked columns;
 - :mod:`~tdm.recording.npz`: ``.npz`` archives, headers before data, bounded loads;

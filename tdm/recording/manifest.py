@@ -11,17 +11,15 @@ a mapping. Keys the TDM does not use are not checked.
 from __future__ import annotations
 
 import json
-from datetime import datetime, timezone
 from pathlib import Path
 
+from groundfloor.recording import FORMAT, FORMAT_VERSION, MANIFEST, parse_start_time as _parse_iso
 from tdm.errors import RecordingError
 from tdm.recording import values
 from tdm.recording.files import decode_utf8, read_bytes
 
 __all__ = ["read_manifest", "start_time_unix_s", "MAX_DURATION_S", "FORMAT", "FORMAT_VERSION"]
 
-FORMAT = "raysim-recording"
-FORMAT_VERSION = 1
 #: Longest run the TDM reads, s (7 days): every size derived from a duration is bounded by it.
 MAX_DURATION_S = 7 * 86_400.0
 #: A manifest is a few kB; a bigger file is not one (read whole, so bounded).
@@ -89,7 +87,7 @@ def read_manifest(recording: Path) -> dict:
     recording = Path(recording)
     if not recording.is_dir():
         raise RecordingError(str(recording), "(directory)", "not a directory")
-    path = recording / "manifest.json"
+    path = recording / MANIFEST
     data = read_bytes(path, missing="missing: not a recording directory", max_bytes=MAX_MANIFEST_BYTES)
     return check_manifest(_load_json(path, data), path)
 
@@ -99,14 +97,11 @@ def parse_start_time(text: object, path: Path) -> float:
     if not isinstance(text, str):
         raise RecordingError(str(path), "start_time", f"must be an ISO 8601 time string, not {values.describe(text)}")
     try:
-        when = datetime.fromisoformat(text.strip().replace("Z", "+00:00"))
+        return _parse_iso(text)
     except ValueError:
         raise RecordingError(str(path), "start_time", f"not an ISO 8601 time: {text[:40]!r}") from None
-    if when.tzinfo is None:
-        when = when.replace(tzinfo=timezone.utc)
-    return when.timestamp()
 
 
 def start_time_unix_s(manifest: dict, recording: Path) -> float:
     """UNIX time of the recording's start, s (``manifest.json: start_time``)."""
-    return parse_start_time(manifest.get("start_time"), Path(recording) / "manifest.json")
+    return parse_start_time(manifest.get("start_time"), Path(recording) / MANIFEST)

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from groundfloor.recording import OWNSHIP
 from tdm.detections import ReadStats
 from tdm.errors import RecordingError
 from tdm.recording import values
@@ -86,7 +87,7 @@ def read_ownship(recording: Path, stats: ReadStats | None = None) -> dict[str, n
         One column per field of :data:`OWNSHIP_FIELDS`: ``t`` s, ``lat``/``lon`` deg, ``x``/``y``/``z`` m,
         angles deg, ``sog_mps`` m/s.
     """
-    path = Path(recording) / "ownship.jsonl"
+    path = Path(recording) / OWNSHIP
     rows, numbers = read_jsonl_lines(path, stats)
     if not rows:
         raise RecordingError(str(path), "(file)", "holds no navigation samples")

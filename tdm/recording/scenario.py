@@ -14,6 +14,8 @@ from pathlib import Path
 
 import yaml
 
+from groundfloor.frames import MOUNT_KEYS
+from groundfloor.recording import SCENARIO
 from tdm.errors import RecordingError
 from tdm.recording import values
 from tdm.recording.files import decode_utf8, read_bytes
@@ -24,9 +26,7 @@ __all__ = ["read_scenario", "check_scenario", "CHECKED", "MAX_UPDATE_RATE_HZ"]
 MAX_UPDATE_RATE_HZ = 100.0
 #: A resolved scenario is a few kB (the world's meshes are separate files).
 MAX_SCENARIO_BYTES = 16 << 20
-_MOUNT = {"x_m": ("number", -1000.0, 1000.0), "y_m": ("number", -1000.0, 1000.0), "z_m": ("number", -1000.0, 1000.0),
-          "roll_deg": ("number", -360.0, 360.0), "pitch_deg": ("number", -360.0, 360.0),
-          "yaw_deg": ("number", -360.0, 360.0)}
+_MOUNT = {k: ("number", -1000.0, 1000.0) if k.endswith("_m") else ("number", -360.0, 360.0) for k in MOUNT_KEYS}
 
 #: Key path -> (kind, low, high); "rate" is a number > low, "number" one >= low, "count" a whole number.
 CHECKED: dict[str, tuple[str, float, float]] = {
@@ -106,7 +106,7 @@ def read_scenario(recording: Path) -> dict:
         Missing or unreadable file, not UTF-8, not YAML, not a mapping, or a value the TDM uses
         out of its type or bounds.
     """
-    path = Path(recording) / "scenario.yaml"
+    path = Path(recording) / SCENARIO
     text = decode_utf8(read_bytes(path, missing="missing: not a recording directory", max_bytes=MAX_SCENARIO_BYTES),
                        path)
     if not text.strip():

@@ -16,6 +16,7 @@ import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from groundfloor.recording import AIS_NMEA, LIDAR_PCAP
 from tdm.detections import ReadStats
 from tdm.pcap import check_pcap_header
 from tdm.recording.files import directory_present, is_present, regular_file
@@ -106,11 +107,11 @@ def summarise(recording: Path) -> RecordingSummary:
     nav = read_ownship(rec, stats)
     summary = RecordingSummary(manifest, int(nav["t"].shape[0]), float(nav["t"][-1]))
     summary.sweep_files = _check_sweeps(rec, scenario, stats)
-    pcap = rec / "lidar" / "hdl32e.pcap"
+    pcap = rec / LIDAR_PCAP
     if is_present(pcap):
         check_pcap_header(pcap)
         summary.pcap_bytes = os.stat(pcap).st_size
-    ais = rec / "ais" / "ais.nmea"
+    ais = rec / AIS_NMEA
     if is_present(ais):
         regular_file(ais)
         with open(ais, "rb") as handle:  # in blocks: memory flat whatever the file's size

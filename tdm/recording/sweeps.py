@@ -1,6 +1,7 @@
 """LiDAR and radar sweep files (``lidar/sweeps/NNNNNN.npz``, ``radar/sweeps/NNNNNN.npz``) against their contract.
 
-A sweep's arrays are described by :class:`SweepSchema` (docs/formats.md): each array's name, dtype
+A sweep's arrays are described by :class:`SweepSchema` (the recording contract,
+:mod:`groundfloor.recording`, which raysim's writers follow too; docs/formats.md): each array's name, dtype
 (either byte order) and axes; arrays sharing an axis must agree on its length (LiDAR: one entry
 per point; radar: ``echo`` is spokes x samples, ``azimuth_deg``, ``heading_deg`` and ``time`` one
 per spoke, ``range_m`` one per sample, ``object_id`` and ``object_spokes`` one per object).
@@ -16,75 +17,16 @@ a readable archive at all raises :class:`tdm.recording.npz.Unreadable`.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from groundfloor.recording import LIDAR_SWEEP, RADAR_SWEEP, SCHEMAS, ArraySpec, SweepSchema
 from tdm.errors import RecordingError
 from tdm.recording.npz import ArrayHeader, NpzFile
 
 __all__ = ["ArraySpec", "SweepSchema", "LIDAR_SWEEP", "RADAR_SWEEP", "SCHEMAS", "check_layout", "check_values",
            "read_sweep", "read_sweep_layout", "unreadable_warning"]
-
-
-@dataclass(frozen=True)
-class ArraySpec:
-    """One array of a sweep file.
-
-    Attributes
-    ----------
-    name, dtype : str
-        Array name and its dtype (``np.dtype`` text, native byte order; either order is accepted).
-    axes : tuple of str
-        Name of each dimension; arrays sharing a name share its length.
-    required : bool
-        Must be in every file (else only checked when present).
-    low, high : float, optional
-        Bounds of the values (checked when the array is loaded).
-    ascending : bool
-        Values must increase strictly.
-    """
-
-    name: str
-    dtype: str
-    axes: tuple[str, ...]
-    required: bool = True
-    low: float | None = None
-    high: float | None = None
-    ascending: bool = False
-
-
-@dataclass(frozen=True)
-class SweepSchema:
-    """The arrays of one sensor's sweep files."""
-
-    sensor: str
-    arrays: tuple[ArraySpec, ...]
-
-    def spec(self, name: str) -> ArraySpec | None:
-        return next((a for a in self.arrays if a.name == name), None)
-
-
-_P = ("points",)
-_XYZ = {"low": -1.0e4, "high": 1.0e4}  # m: a LiDAR measures to 100-300 m
-_DEG = {"low": -360.0, "high": 720.0}  # deg: the format's [0, 360), with room for another convention
-LIDAR_SWEEP = SweepSchema("lidar", (
-    ArraySpec("x", "float32", _P, **_XYZ), ArraySpec("y", "float32", _P, **_XYZ), ArraySpec("z", "float32", _P, **_XYZ),
-    ArraySpec("intensity", "uint8", _P), ArraySpec("ring", "uint8", _P, high=31), ArraySpec("time", "float64", _P),
-    ArraySpec("azimuth_deg", "float32", _P, **_DEG),
-    ArraySpec("object_id", "int32", _P, required=False, low=-1),
-    ArraySpec("return_source", "uint8", _P, required=False), ArraySpec("return_index", "uint8", _P, required=False),
-))
-RADAR_SWEEP = SweepSchema("radar", (
-    ArraySpec("echo", "uint8", ("spokes", "samples"), high=15),
-    ArraySpec("azimuth_deg", "float32", ("spokes",), **_DEG), ArraySpec("heading_deg", "float32", ("spokes",), **_DEG),
-    ArraySpec("time", "float64", ("spokes",)),
-    ArraySpec("range_m", "float32", ("samples",), low=0.0, high=1.0e7, ascending=True),
-    ArraySpec("object_id", "int32", ("objects",), required=False),
-    ArraySpec("object_spokes", "int32", ("objects",), required=False, low=0),
-))
-SCHEMAS = {"lidar": LIDAR_SWEEP, "radar": RADAR_SWEEP}
 
 
 def unreadable_warning(sensor: str, reason: str) -> str:

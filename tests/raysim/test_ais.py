@@ -13,7 +13,7 @@ from pyais import decode, encode_dict
 from raysim.cli import main
 from raysim.geodesy import LocalFrame
 from raysim.scenario import load_scenario
-from raysim.sensors import ais_fields as fields
+from raysim import ais_fields as fields
 from raysim.sensors.ais import ais_lines, radio_horizon_m, received_messages, ship_messages
 from raysim.world import World
 from tests.conftest import BASE, REPO as BASE_DIR

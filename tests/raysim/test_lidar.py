@@ -11,7 +11,7 @@ import trimesh
 
 from raysim.cli import main
 from raysim.geodesy import LocalFrame
-from raysim.sensors import hdl32e
+from groundfloor import hdl32e
 
 ORIGIN = (59.43, 10.47)
 FRAME = LocalFrame(*ORIGIN)

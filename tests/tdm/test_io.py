@@ -15,13 +15,32 @@ from tdm.io import read_manifest, read_ownship, read_truth
 from tests.conftest import BASE, REPO
 
 
-def test_tdm_never_imports_raysim():
-    for path in (REPO / "tdm").rglob("*.py"):
+def _imported_packages(package: str) -> dict:
+    """Path -> the top-level packages each module of ``package`` imports (absolute imports, parsed with ast)."""
+    found = {}
+    for path in (REPO / package).rglob("*.py"):
         tree = ast.parse(path.read_text(encoding="utf-8"))
+        names = set()
         for node in ast.walk(tree):
-            names = [a.name for a in node.names] if isinstance(node, ast.Import) else (
-                [node.module or ""] if isinstance(node, ast.ImportFrom) else [])
-            assert not any(n == "raysim" or n.startswith("raysim.") for n in names), path
+            if isinstance(node, ast.Import):
+                names.update(a.name.split(".")[0] for a in node.names)
+            elif isinstance(node, ast.ImportFrom) and node.level == 0:
+                names.add((node.module or "").split(".")[0])
+        found[path] = names
+    return found
+
+
+def test_tdm_never_imports_raysim():
+    for path, names in _imported_packages("tdm").items():
+        assert "raysim" not in names, path
+
+
+def test_groundfloor_imports_neither_raysim_nor_tdm():
+    """groundfloor is the floor under both wings (docs/architecture.md "Floors")."""
+    found = _imported_packages("groundfloor")
+    assert found
+    for path, names in found.items():
+        assert not names & {"raysim", "tdm", "benchmarks"}, path
 
 
 @pytest.fixture

@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 import yaml
 
-from raysim.sensors.hdl32e import CYCLE_DT_S, FIRING_DT_S, RING
+from groundfloor.hdl32e import CYCLE_DT_S, FIRING_DT_S, RING
 from tdm.detections import ReadStats
 from tdm.errors import RecordingError
 from tdm.pcap import iter_pcap_sweeps

@@ -22,6 +22,7 @@ from typing import Callable, Iterator
 
 import numpy as np
 
+from groundfloor.units import KNOTS_PER_MPS
 from raysim.recording.jsonl import every, truth_epochs
 from raysim.recording.rosbag.msgs import BagMessage, duration, header, make, point, pose, yaw_quaternion
 
@@ -32,7 +33,6 @@ KIND_COLOURS = {"ownship": (0.2, 0.6, 1.0), "ship": (1.0, 0.4, 0.2), "iceberg": 
                 "buoy": (1.0, 0.85, 0.0), "mesh": (0.6, 0.6, 0.6)}
 TARGET_COLOUR = (0.1, 1.0, 0.3)
 LABEL_HEIGHT_M = 4.0  # text size of the labels
-KNOTS_PER_MPS = 3600.0 / 1852.0
 _CUBE, _TEXT, _DELETEALL = 1, 9, 3  # visualization_msgs/Marker type and action codes
 
 NsOf = Callable[[float], int]

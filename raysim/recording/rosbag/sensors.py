@@ -13,6 +13,8 @@ from typing import Callable, Iterator
 
 import numpy as np
 
+from groundfloor.frames import mount_transform
+from groundfloor.recording import AIS_NMEA, LIDAR_SWEEPS, RADAR_SWEEPS
 from raysim.recording.pointclouds import PCD_DTYPE, velodyne_points
 from raysim.recording.rosbag.msgs import BagMessage, duration, header, make, point, quaternion, quaternion_from_matrix
 
@@ -34,8 +36,6 @@ def _transform(t_ns: int, parent: str, child: str, rot: np.ndarray, trans) -> ob
 
 def static_transforms(scenario, t0_ns: int) -> Iterator[BagMessage]:
     """``/tf_static``: base_link -> lidar, radar (the mounts) and ais (the VHF antenna above the sea)."""
-    from raysim.sensors.lidar import mount_transform
-
     transforms = []
     for frame, sensor in (("lidar", scenario.sensors.lidar), ("radar", scenario.sensors.radar)):
         rot, trans = mount_transform(sensor.mount)
@@ -47,7 +47,7 @@ def static_transforms(scenario, t0_ns: int) -> Iterator[BagMessage]:
 def lidar_clouds(recording: Path, ns_of: NsOf) -> Iterator[BagMessage]:
     """``/lidar/points``: one PointCloud2 per revolution in the velodyne driver's layout, frame ``lidar``."""
     fields = [make("sensor_msgs/msg/PointField", name=n, offset=o, datatype=d, count=1) for n, o, d in _CLOUD_FIELDS]
-    for path in sorted((recording / "lidar" / "sweeps").glob("*.npz")):
+    for path in sorted((recording / LIDAR_SWEEPS).glob("*.npz")):
         with np.load(path) as sweep:
             points = velodyne_points(sweep)
             n = points.size
@@ -64,7 +64,7 @@ def radar_sectors(recording: Path, ns_of: NsOf) -> Iterator[BagMessage]:
     Both stamped at spoke 0 of the revolution; the picture is ``radar/ppi/NNNNNN.png`` as written.
     """
     ppi_dir = recording / "radar" / "ppi"
-    for path in sorted((recording / "radar" / "sweeps").glob("*.npz")):
+    for path in sorted((recording / RADAR_SWEEPS).glob("*.npz")):
         with np.load(path) as sweep:
             echo, az, times, rng = sweep["echo"], sweep["azimuth_deg"], sweep["time"], sweep["range_m"]
         spokes = echo.shape[0]
@@ -97,7 +97,7 @@ def _ais_times(recording: Path) -> Iterator[tuple[float | None, int | None, str]
                 row = json.loads(line)
                 yield float(row["t"]), None, row["sentence"]
         return
-    tagged = recording / "ais" / "ais.nmea"
+    tagged = recording / AIS_NMEA
     if tagged.is_file():
         with open(tagged, encoding="ascii") as handle:
             for line in handle:
