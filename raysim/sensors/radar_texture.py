@@ -28,6 +28,15 @@ from raysim.sensors import radar_physics as phys
 
 __all__ = ["SeaTexture"]
 
+#: Highest Douglas sea state of the REF 3.8 wind table.
+MAX_SEA_STATE = 6
+#: Correlation length along the wind over that across it: ``sqrt(3 cos^2 A + 1)`` at A = 0 and 90 deg.
+ALONG_OVER_ACROSS = 2.0
+#: Tile cells per across-wind correlation length.
+CELLS_PER_LENGTH = 2.0
+#: Key frames kept in memory (a revolution needs two; the oldest goes first).
+KEY_FRAMES_KEPT = 4
+
 
 class SeaTexture:
     """Unit-variance Gaussian sea texture at world points and times.
@@ -45,10 +54,10 @@ class SeaTexture:
     """
 
     def __init__(self, seed: int, sea_state: int, wind_from_deg: float, tile_cells: int = 1024):
-        w = phys.TEXTURE_WIND_MPS[int(np.clip(sea_state, 0, 6))]
+        w = phys.TEXTURE_WIND_MPS[int(np.clip(sea_state, 0, MAX_SEA_STATE))]
         base = (math.pi / 2.0) * w * w / phys.G_MPS2
-        self.length_along_m, self.length_across_m = 2.0 * base, base  # sqrt(3 cos^2 A + 1) at A = 0, 90 deg
-        self.cell_m = self.length_across_m / 2.0
+        self.length_along_m, self.length_across_m = ALONG_OVER_ACROSS * base, base  # sqrt(3 cos^2 A + 1) at A = 0, 90 deg
+        self.cell_m = self.length_across_m / CELLS_PER_LENGTH
         self.n = int(tile_cells)
         if self.n & (self.n - 1):
             raise ValueError(f"tile_cells must be a power of two, got {tile_cells}")
@@ -69,7 +78,7 @@ class SeaTexture:
 
     def _key(self, k: int) -> np.ndarray:
         if k not in self._keys:
-            if len(self._keys) > 3:
+            if len(self._keys) >= KEY_FRAMES_KEPT:
                 self._keys.pop(min(self._keys))
             white = stream(self.seed, f"radar.texture.{k}").standard_normal((self.n, self.n), dtype=np.float32)
             field = scipy.fft.irfft2(scipy.fft.rfft2(white) * self._transfer, s=(self.n, self.n))
