@@ -46,14 +46,49 @@ from raysim.recording.ppi import PpiLabels, write_ppi
 from raysim.scene import NO_HIT, SEA_ID
 from raysim.sensors import radar_physics as phys
 from raysim.sensors.carrier import CarrierScene
+from raysim.sensors.context import SensorContext
 from raysim.sensors.radar_facets import FacetTable
 from raysim.sensors.radar_texture import SeaTexture
+from raysim.world import World
 
 
 #: mean of 10 log10 of exponential noise power of mean 1: -10 gamma / ln 10 (Euler's gamma), dB
 NOISE_LOG_MEAN_DB = -2.507
 #: Largest sea-clutter mean SNR, dB: far above video level 15 (about 55 dB) and far below float32's 385 dB.
 MAX_CLUTTER_DB = 200.0
+SECONDS_PER_MINUTE = 60.0
+DEG_PER_TURN = 360.0
+M_PER_KM = 1000.0
+#: Lowest antenna height the geometry uses, m: the ray fan's design height (a mount at or below the
+#: waterline still gets a fan) and, smaller, the height in the clutter tables (a grazing angle exists).
+FAN_MIN_HEIGHT_M = 0.1
+CLUTTER_MIN_HEIGHT_M = 0.05
+#: Rays are cast to this multiple of the range scale plus a margin, m: echoes from beyond the range
+#: scale still spread into its last bins through the range point-spread and the beam.
+CAST_RANGE_FACTOR = 1.5
+CAST_RANGE_MARGIN_M = 10.0
+#: Smallest grazing angle the clutter formulas are evaluated at, deg (below it log terms run away).
+MIN_GRAZING_DEG = 1e-3
+#: Steepest grazing angle of the NRL sea-clutter fit, deg (REF 3.7: 0.1 to 60 deg).
+NRL_MAX_GRAZING_DEG = 60.0
+#: Clutter mean beyond the horizon, dB: none, but finite so that it can be interpolated.
+NO_CLUTTER_DB = -300.0
+#: Floor of the summed power before taking dB (no log of 0).
+POWER_FLOOR = 1e-30
+#: Full width at half maximum of a Gaussian in standard deviations, 2 sqrt(2 ln 2).
+FWHM_PER_SIGMA = 2.3548
+#: The range point-spread is applied when its standard deviation is at least this many range bins.
+MIN_SPREAD_BINS = 0.3
+#: Steps of the clutter mean and texture across one azimuth beamwidth (formed on every sub-th spoke).
+CLUTTER_STEPS_PER_BEAM = 6
+#: Antenna height step of the clutter table's slope, m (the table at h_mid +- this).
+CLUTTER_HEIGHT_STEP_M = 0.05
+#: Grazing angles above this, deg, get the exact arcsine in the vertical pattern (the first range bins).
+STEEP_GRAZING_DEG = 10.0
+#: Swell angle that makes Ward's swell term vanish (cos(2 x 45 deg) = 0), deg: the swell term is added per spoke.
+NO_SWELL_DEG = 45.0
+#: Range bins of the moving average that normalises the texture's standard deviation along range.
+TEXTURE_STD_WINDOW_BINS = 33
 
 
 @dataclass(frozen=True)
@@ -143,7 +178,7 @@ class RadarRenderer:
         Model parameters; by default those of the scenario's ``sensors.radar`` block.
     """
 
-    def __init__(self, world, scene: CarrierScene, params: RadarParams | None = None):
+    def __init__(self, world: World, scene: CarrierScene, params: RadarParams | None = None):
         self.world = world
         self.scene = scene
         s = world.scenario
@@ -152,7 +187,7 @@ class RadarRenderer:
         self.seed = s.seed
         self.p = p = params or RadarParams.from_config(self.cfg)
         self.spokes, self.samples = int(self.cfg.spokes), int(self.cfg.samples)
-        self.rev_s = 60.0 / self.cfg.rpm
+        self.rev_s = SECONDS_PER_MINUTE / self.cfg.rpm
         self.mount_rotation, self.mount_translation = mount_transform(self.cfg.mount)
         # range_m[j] = j dR: the first sample at the antenna, the last at the range scale (REF 3 table)
         self.dr = self.cfg.range_m / (self.samples - 1)
@@ -163,9 +198,9 @@ class RadarRenderer:
         self.facets = FacetTable([o for o in world.objects if o.object_id != world.own_ship.object_id])
         # ray fan: dense enough to resolve p.resolve_m at the range scale or, if nearer, at the radar
         # horizon of a top_height_m object (beyond it nothing that tall is seen: REF 3.4)
-        h = max(self.cfg.mount.z_m, 0.1)
+        h = max(self.cfg.mount.z_m, FAN_MIN_HEIGHT_M)
         resolve_range = min(self.cfg.range_m, float(phys.horizon_m(h) + phys.horizon_m(p.top_height_m)))
-        spoke_deg = 360.0 / self.spokes
+        spoke_deg = DEG_PER_TURN / self.spokes
         az_spacing_deg = math.degrees(p.resolve_m / resolve_range)
         self.k_az = max(1, int(math.ceil(spoke_deg / az_spacing_deg - 1e-9)))
         self.az_offsets_deg = ((np.arange(self.k_az) + 0.5) / self.k_az - 0.5) * spoke_deg
@@ -187,7 +222,7 @@ class RadarRenderer:
         self.texture_field = SeaTexture(self.seed, self.env.sea_state, self.env.wind_from_deg)
         # per-range receiver terms (the same every spoke)
         self.stc_db = phys.stc_gain_db(self.r64, p.stc_a0_db, p.stc_n, p.stc_r0_m).astype(np.float32)
-        self.rain_loss = phys.undb(-2.0 * float(phys.rain_attenuation_db_per_km(self.env.rain_mm_per_h)) / 1000.0
+        self.rain_loss = phys.undb(-2.0 * float(phys.rain_attenuation_db_per_km(self.env.rain_mm_per_h)) / M_PER_KM
                                    * self.r64).astype(np.float32)
         self.rain_mean = None
         if self.env.rain_mm_per_h > 0:
@@ -196,7 +231,7 @@ class RadarRenderer:
             eta = phys.rain_eta_m2_per_m3(self.env.rain_mm_per_h, p.f_ghz)
             self.rain_mean = phys.snr(eta * volume, self.r64, **self.snr_kw).astype(np.float32)
         self.blank = int(np.searchsorted(self.range_m, p.blanking_m, side="left"))
-        self._clutter_mean_db = self._clutter_mean_db_table(np.array([max(self.cfg.mount.z_m, 0.05)]))[0]
+        self._clutter_mean_db = self._clutter_mean_db_table(np.array([max(self.cfg.mount.z_m, CLUTTER_MIN_HEIGHT_M)]))[0]
         self.n_revolutions = int(math.floor(s.duration_s / self.rev_s + 1e-9))
         self.rev_wall_s: list[float] = []
 
@@ -221,8 +256,8 @@ class RadarRenderer:
         """The rays of revolution ``rev``: spoke times, poses and the world/body ray arrays."""
         S, K = self.spokes, self.k
         idx = np.arange(S)
-        t = (rev * S + idx) / (S * self.cfg.rpm / 60.0)
-        azimuth = idx * (360.0 / S)
+        t = (rev * S + idx) / (S * self.cfg.rpm / SECONDS_PER_MINUTE)
+        azimuth = idx * (DEG_PER_TURN / S)
         poses, rot, pos = self._poses(t)
         d_s = self._sensor_directions(azimuth)  # (S, K, 3)
         d_w = np.einsum("sij,skj->ski", rot, d_s).reshape(S * K, 3)
@@ -235,12 +270,12 @@ class RadarRenderer:
         """(H, N) mean sea clutter, dB re. noise, at the level boresight: NRL sigma0 x cell area (no pattern)."""
         p = self.p
         psi = phys.grazing_angle_deg(antenna_h[:, None], self.r64[None, :])
-        psi_c = np.where(np.isfinite(psi), np.maximum(psi, 1e-3), 1.0)
+        psi_c = np.where(np.isfinite(psi), np.maximum(psi, MIN_GRAZING_DEG), 1.0)
         area = phys.clutter_cell_area_m2(self.r64[None, :], psi_c, self.beam_eq_rad, self.cell_m)
         # the NRL fit holds from 0.1 to 60 deg grazing (REF 3.7); steeper cells (the first metres) keep the 60 deg value
-        sigma0_db = phys.nrl_sigma0_db(np.minimum(psi_c, 60.0), p.f_ghz, self.env.sea_state, p.polarisation)
+        sigma0_db = phys.nrl_sigma0_db(np.minimum(psi_c, NRL_MAX_GRAZING_DEG), p.f_ghz, self.env.sea_state, p.polarisation)
         mean_db = sigma0_db + phys.db(area) + phys.snr_db(1.0, self.r64[None, :], **self.snr_kw)
-        return np.where(np.isfinite(psi), mean_db, -300.0)  # beyond the horizon: none (finite, for interpolation)
+        return np.where(np.isfinite(psi), mean_db, NO_CLUTTER_DB)  # beyond the horizon: none (finite, for interpolation)
 
     # ------------------------------------------------------------------ one revolution
 
@@ -250,8 +285,8 @@ class RadarRenderer:
         p = self.p
         t, azimuth, poses, rot, pos, o_w, d_w, o_b, d_b = self.rays(rev)
         heading = heading_deg_from_yaw(poses.yaw_rad)
-        antenna_h = np.maximum(pos[:, 2], 0.05)
-        max_range = self.cfg.range_m * 1.5 + 10.0
+        antenna_h = np.maximum(pos[:, 2], CLUTTER_MIN_HEIGHT_M)
+        max_range = self.cfg.range_m * CAST_RANGE_FACTOR + CAST_RANGE_MARGIN_M
         hits, on_carrier = self.scene.cast(o_w, d_w, np.repeat(t, K), o_b, d_b, max_range_m=max_range)
         targets, first_hit, seen = self._targets(hits, on_carrier, t, o_w, d_w, antenna_h)
         clutter, texture = self._sea_clutter(rev, t, rot, pos, azimuth, heading, antenna_h, first_hit)
@@ -265,7 +300,7 @@ class RadarRenderer:
         if self.env.rain_mm_per_h > 0:
             total = total * self.rain_loss[None, :]
         total = total + stream(self.seed, f"radar.noise.{rev}").standard_exponential((S, N), dtype=np.float32)
-        p_db = 10.0 * np.log10(np.maximum(total, np.float32(1e-30)), dtype=np.float32) + self.stc_db[None, :]
+        p_db = 10.0 * np.log10(np.maximum(total, np.float32(POWER_FLOOR)), dtype=np.float32) + self.stc_db[None, :]
         if p.ftc_m > 0:
             p_db = self._ftc(p_db)
         echo = phys.quantise(p_db, p.video_floor_db, p.video_step_db)
@@ -320,8 +355,8 @@ class RadarRenderer:
         targets = np.bincount(flat, weights=power[ok], minlength=S * N).reshape(S, N)
         # range point-spread (physical resolution, REF 3.3) on the spokes hit, when bins are finer than it
         rows = np.unique(spoke_h[ok])
-        sigma_bins = p.range_resolution_m / 2.3548 / self.dr
-        if sigma_bins > 0.3 and rows.size:
+        sigma_bins = p.range_resolution_m / FWHM_PER_SIGMA / self.dr
+        if sigma_bins > MIN_SPREAD_BINS and rows.size:
             targets[rows] = gaussian_filter1d(targets[rows], sigma_bins, axis=1, mode="constant") * (
                 math.sqrt(2 * math.pi) * sigma_bins)
         # azimuth beam: circular convolution over spokes, on the range bins that hold an echo
@@ -340,8 +375,8 @@ class RadarRenderer:
         """
         S, N = self.spokes, self.samples
         p = self.p
-        beam_spokes = p.beam_az_deg / (360.0 / S)
-        sub = max(1, int(beam_spokes // 6))  # 4 at 2048 spokes and 5.2 deg: 0.7 deg steps in a 5.2 deg beam
+        beam_spokes = p.beam_az_deg / (DEG_PER_TURN / S)
+        sub = max(1, int(beam_spokes // CLUTTER_STEPS_PER_BEAM))  # 4 at 2048 spokes and 5.2 deg: 0.7 deg steps in a 5.2 deg beam
         while S % sub:
             sub -= 1
         rows = np.arange(0, S, sub)
@@ -349,13 +384,13 @@ class RadarRenderer:
         # mean level: NRL sigma0 x cell area through the radar equation, linear in the antenna height about
         # its mean over the revolution (heave, roll and pitch move it by decimetres)
         h_mid = float(np.mean(antenna_h))
-        table = self._clutter_mean_db_table(np.array([h_mid - 0.05, h_mid + 0.05]))
-        slope = ((table[1] - table[0]) / 0.1).astype(np.float32)
+        table = self._clutter_mean_db_table(np.array([h_mid - CLUTTER_HEIGHT_STEP_M, h_mid + CLUTTER_HEIGHT_STEP_M]))
+        slope = ((table[1] - table[0]) / (2.0 * CLUTTER_HEIGHT_STEP_M)).astype(np.float32)
         dh = (h_rows - h_mid).astype(np.float32)
         mean_db = (table.mean(axis=0).astype(np.float32))[None, :] + dh[:, None] * slope[None, :]
         # vertical pattern at the sea cell's depression in the antenna frame (roll and pitch included)
         psi = phys.grazing_angle_deg(h_mid, self.r64)
-        psi_r = np.radians(np.where(np.isfinite(psi), np.maximum(psi, 1e-3), 1.0)).astype(np.float32)
+        psi_r = np.radians(np.where(np.isfinite(psi), np.maximum(psi, MIN_GRAZING_DEG), 1.0)).astype(np.float32)
         bearing = np.radians(azimuth[rows])
         dxy = np.stack([np.cos(bearing), -np.sin(bearing), np.zeros(rows.size)], 1)  # horizontal boresight, sensor frame
         bore = np.einsum("sij,sj->si", rot[rows], dxy)
@@ -365,7 +400,7 @@ class RadarRenderer:
         sin_el = np.cos(psi_r)[None, :] * sin_tilt[:, None] - np.sin(psi_r)[None, :] * z_ax[:, 2].astype(np.float32)[:, None]
         # two-way Gaussian pattern in dB at the elevation asin(sin_el): ~ sin_el (0.5 % at 10 deg) except in the
         # first, steep range bins
-        steep = int(np.count_nonzero(np.degrees(psi_r) > 10.0))
+        steep = int(np.count_nonzero(np.degrees(psi_r) > STEEP_GRAZING_DEG))
         el_sq = sin_el * sin_el
         el_sq[:, :steep] = np.arcsin(np.clip(sin_el[:, :steep], -1.0, 1.0)) ** 2
         mean_db += np.float32(2.0 * phys.one_way_gain_db(math.degrees(1.0), p.beam_el_deg)) * el_sq
@@ -387,12 +422,12 @@ class RadarRenderer:
             width = max(1, int(round(beam_spokes / sub)))
             zt = np.ascontiguousarray(z.T)
             zt = uniform_filter1d(uniform_filter1d(zt, width, axis=1, mode="wrap"), width, axis=1, mode="wrap")
-            std = np.maximum(uniform_filter1d(zt.std(axis=1), 33, mode="nearest"), 1e-6)
+            std = np.maximum(uniform_filter1d(zt.std(axis=1), TEXTURE_STD_WINDOW_BINS, mode="nearest"), 1e-6)
             z = np.ascontiguousarray((zt / std[:, None]).T)
             # Ward's shape (REF 3.8) varies with range (grazing, cell area) and with the look direction to the swell
-            psi_c = np.where(np.isfinite(psi), np.maximum(psi, 1e-3), 1.0)
+            psi_c = np.where(np.isfinite(psi), np.maximum(psi, MIN_GRAZING_DEG), 1.0)
             area = phys.clutter_cell_area_m2(self.r64, psi_c, self.beam_eq_rad, self.cell_m)
-            log_nu_r = np.log(phys.ward_shape_nu(psi_c, area, p.polarisation, 45.0))  # cos(90 deg) = 0: no swell term
+            log_nu_r = np.log(phys.ward_shape_nu(psi_c, area, p.polarisation, NO_SWELL_DEG))  # cos(90 deg) = 0: no swell term
             swell = -np.cos(np.radians(2.0 * ((azimuth[rows] + heading[rows]) - self.env.wind_from_deg))) / 3.0 * math.log(10.0)
             texture = self.gamma(z, (log_nu_r[None, :] + swell[:, None]).astype(np.float32))
             mean *= texture
@@ -445,7 +480,7 @@ class RadarRenderer:
         return counts
 
 
-def render_radar(ctx) -> None:
+def render_radar(ctx: SensorContext) -> None:
     """The ``radar`` entry for :data:`raysim.render.SENSOR_RENDERERS`."""
     renderer = RadarRenderer(ctx.world, ctx.scene())
     from tqdm import tqdm

@@ -176,12 +176,6 @@ def ward_shape_nu(psi_deg, cell_area_m2, pol: str = "HH", theta_swell_deg=0.0, n
     return np.clip(np.nan_to_num(10.0 ** log_nu, nan=nu_min), nu_min, nu_max)
 
 
-def texture_correlation_length_m(sea_state: int, aspect_deg=0.0) -> float:
-    """Range correlation length of the texture: ``(pi/2)(W^2/g) sqrt(3 cos^2(Aw) + 1)`` (REF 3.8)."""
-    w = TEXTURE_WIND_MPS[int(np.clip(sea_state, 0, 6))]
-    return float(np.mean((math.pi / 2.0) * (w * w / G_MPS2) * np.sqrt(3.0 * np.cos(np.radians(aspect_deg)) ** 2 + 1.0)))
-
-
 class GammaQuantiles:
     """Fast Gamma(nu, mean 1) quantiles of standard-normal values, by table lookup.
 
