@@ -28,13 +28,15 @@ import re
 import shutil
 import signal
 import socket
+import sys
 import threading
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Iterator
 
 __all__ = ["EXIT_INTERRUPTED", "EXIT_TERMINATED", "HOST_MARKER", "OutputWriteError", "Sigterm", "Staging", "Terminated",
-           "WRITE_ERRNOS", "atomic_path", "is_write_fault", "remove_stale", "sigterm_as_interrupt", "write_fault"]
+           "WRITE_ERRNOS", "atomic_path", "is_write_fault", "remove_stale", "report_fault", "sigterm_as_interrupt",
+           "write_fault"]
 
 #: ``errno`` values that mean "the output cannot be written" (not a bug, not bad input): no space
 #: left on the device, disk quota exceeded, read-only file system, I/O error, file too large (a
@@ -81,6 +83,26 @@ def write_fault(exc: OSError, directory: Path) -> OutputWriteError:
 #: Exit codes of a command stopped by a signal: 128 + the signal's number, as a shell reports it.
 EXIT_INTERRUPTED = 128 + signal.SIGINT  # 130, Ctrl-C
 EXIT_TERMINATED = 128 + signal.SIGTERM  # 143
+
+
+def report_fault(exc: BaseException, out=None, nothing_written: str = "nothing was written") -> int | None:
+    """A command's one line on stderr for an output fault or an interrupt, and its exit code.
+
+    A write fault (:func:`is_write_fault`): ``error: <directory>: writing: <what>``, exit code 2 (the
+    directory: the :class:`OutputWriteError`'s, else ``out``, else the file's name); Ctrl-C or
+    SIGTERM: ``error: interrupted; <nothing_written>`` (or ``terminated``), 130 or 143. Any other
+    exception: None, printed nothing (the caller re-raises it).
+    """
+    if isinstance(exc, KeyboardInterrupt):
+        how = "terminated" if isinstance(exc, Terminated) else "interrupted"
+        print(f"error: {how}; {nothing_written}", file=sys.stderr)
+        return EXIT_TERMINATED if isinstance(exc, Terminated) else EXIT_INTERRUPTED
+    if not is_write_fault(exc):
+        return None
+    where = exc.directory if isinstance(exc, OutputWriteError) else out or exc.filename
+    text = exc.strerror or os.strerror(exc.errno)
+    print(f"error: {where}: writing: {text[:1].lower() + text[1:]}", file=sys.stderr)
+    return 2
 
 
 class Terminated(KeyboardInterrupt):

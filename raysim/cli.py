@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import os
 import sys
 from pathlib import Path
 
@@ -186,11 +185,9 @@ def cmd_batch(args) -> int:
         rows = run_batch(runs, args.out, scheduler=args.scheduler, workers=args.workers,
                          progress=progress_printer(not args.no_progress))
     except KeyboardInterrupt as exc:
-        from raysim.recording.staging import EXIT_INTERRUPTED, EXIT_TERMINATED, Terminated
+        from raysim.recording.staging import report_fault
 
-        how = "terminated" if isinstance(exc, Terminated) else "interrupted"
-        print(f"error: {how}; the finished runs are kept: the same command goes on from there", file=sys.stderr)
-        return EXIT_TERMINATED if isinstance(exc, Terminated) else EXIT_INTERRUPTED
+        return report_fault(exc, nothing_written="the finished runs are kept: the same command goes on from there")
     failed = [r for r in rows if r["status"] != "ok"]
     print(f"batch of {len(rows)} runs in {args.out}: {len(rows) - len(failed)} ok, {len(failed)} failed; "
           f"summary in {args.out / 'summary.csv'}")
@@ -340,8 +337,7 @@ def main(argv: list[str] | None = None) -> int:
     written (full disk, quota, read-only, I/O error), 130 Ctrl-C, 143 SIGTERM; the last four print
     one line ``error: ...`` on stderr and leave no staging directory behind.
     """
-    from raysim.recording.staging import (EXIT_INTERRUPTED, EXIT_TERMINATED, OutputWriteError, Terminated,
-                                          is_write_fault, sigterm_as_interrupt)
+    from raysim.recording.staging import Terminated, report_fault, sigterm_as_interrupt
 
     args = None
     try:
@@ -356,17 +352,11 @@ def main(argv: list[str] | None = None) -> int:
     except InputError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
-    except OSError as exc:
-        if not is_write_fault(exc):
+    except (OSError, KeyboardInterrupt) as exc:  # a write fault or an interrupt: one line (groundfloor.staging)
+        code = report_fault(exc, getattr(args, "out", None))
+        if code is None:
             raise
-        where = exc.directory if isinstance(exc, OutputWriteError) else getattr(args, "out", None) or exc.filename
-        text = exc.strerror or os.strerror(exc.errno)
-        print(f"error: {where}: writing: {text[:1].lower() + text[1:]}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt as exc:
-        how = "terminated" if isinstance(exc, Terminated) else "interrupted"
-        print(f"error: {how}; nothing was written", file=sys.stderr)
-        return EXIT_TERMINATED if isinstance(exc, Terminated) else EXIT_INTERRUPTED
+        return code
 
 
 if __name__ == "__main__":  # pragma: no cover

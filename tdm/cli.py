@@ -13,7 +13,6 @@ appear whole or not at all (:mod:`tdm.staging`); an output that cannot be writte
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 from pathlib import Path
 
@@ -97,7 +96,7 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _main(argv: list[str] | None) -> int:
-    from tdm.staging import EXIT_INTERRUPTED, EXIT_TERMINATED, OutputWriteError, Terminated, is_write_fault
+    from tdm.staging import report_fault
 
     parser = build_parser()
     args = None
@@ -130,17 +129,11 @@ def _main(argv: list[str] | None) -> int:
     except RecordingError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
-    except OSError as exc:
-        if not is_write_fault(exc):
+    except (OSError, KeyboardInterrupt) as exc:  # a write fault or an interrupt: one line (groundfloor.staging)
+        code = report_fault(exc, getattr(args, "out", None))
+        if code is None:
             raise
-        where = exc.directory if isinstance(exc, OutputWriteError) else getattr(args, "out", None) or exc.filename
-        text = exc.strerror or os.strerror(exc.errno)
-        print(f"error: {where}: writing: {text[:1].lower() + text[1:]}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt as exc:
-        how = "terminated" if isinstance(exc, Terminated) else "interrupted"
-        print(f"error: {how}; nothing was written", file=sys.stderr)
-        return EXIT_TERMINATED if isinstance(exc, Terminated) else EXIT_INTERRUPTED
+        return code
 
 
 if __name__ == "__main__":  # pragma: no cover

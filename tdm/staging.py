@@ -26,11 +26,11 @@ import os
 from pathlib import Path
 
 from groundfloor.staging import (EXIT_INTERRUPTED, EXIT_TERMINATED, HOST_MARKER, WRITE_ERRNOS, OutputWriteError,  # noqa: F401
-                                 Sigterm, Staging, Terminated, is_write_fault, remove_stale, sigterm_as_interrupt,
-                                 write_fault)
+                                 Sigterm, Staging, Terminated, is_write_fault, remove_stale, report_fault,
+                                 sigterm_as_interrupt, write_fault)
 
 __all__ = ["EXIT_INTERRUPTED", "EXIT_TERMINATED", "OutputWriteError", "Sigterm", "StagedOutputs", "Terminated", "WRITE_ERRNOS",
-           "is_write_fault", "remove_stale", "sigterm_as_interrupt", "write_fault"]
+           "is_write_fault", "remove_stale", "report_fault", "sigterm_as_interrupt", "write_fault"]
 
 
 class StagedOutputs(Staging):

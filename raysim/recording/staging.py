@@ -19,7 +19,7 @@ from pathlib import Path
 from groundfloor.recording import MANIFEST
 from groundfloor.staging import (EXIT_INTERRUPTED, EXIT_TERMINATED, HOST_MARKER, WRITE_ERRNOS, OutputWriteError,  # noqa: F401
                                  Sigterm, Staging, Terminated, atomic_path, is_write_fault, remove_stale,
-                                 sigterm_as_interrupt, write_fault)
+                                 report_fault, sigterm_as_interrupt, write_fault)
 from raysim.errors import InputError
 
 
