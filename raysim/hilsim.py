@@ -140,7 +140,7 @@ def import_hilsim(obstacles_path: Path, sensors_path: Path, dynamics_path: Path 
     comments : list of str
         Lines about parameters that have no native equivalent.
     """
-    obstacles_file, sensors_file = str(obstacles_path), str(sensors_path)
+    obstacles_file = str(obstacles_path)
     obstacles_data = _load(obstacles_path)
     sensors_data = _load(sensors_path)
     dynamics_data = _load(dynamics_path) if dynamics_path is not None else {}
@@ -148,9 +148,30 @@ def import_hilsim(obstacles_path: Path, sensors_path: Path, dynamics_path: Path 
         if key not in ("fixed_obstacles", "ships"):
             raise InputError(obstacles_file, str(key), "unknown key (allowed: fixed_obstacles, ships)")
     comments: list[str] = []
+    obstacles = _obstacles(obstacles_file, obstacles_data.get("fixed_obstacles") or {})
+    ships = _ships(obstacles_file, obstacles_data.get("ships") or {})
+    sensors, tdm = _sensors(str(sensors_path), sensors_data, comments)
 
+    scenario: dict = {"name": name, "start_time": "2017-06-01T12:00:00Z", "duration_s": float(duration_s), "seed": 7}
+    environment: dict = {}
+    start = None
+    if dynamics_path is not None:
+        start = _dynamics(str(dynamics_path), dynamics_data, scenario, environment, sensors, comments)
+    if environment:
+        scenario["environment"] = environment
+    scenario["own_ship"] = _own_ship(obstacles_file, route, start, speed_kn)
+    scenario["sensors"] = {k: v for k, v in sensors.items() if v and v != {"noise": {}}}
+    if tdm:
+        scenario["tdm"] = tdm
+    scenario["obstacles"] = obstacles
+    scenario["ships"] = ships
+    return scenario, comments
+
+
+def _obstacles(obstacles_file: str, fixed: dict) -> list[dict]:
+    """The thesis's fixed obstacles (``RADIUS=``, ``COORD=``) as native icebergs."""
     obstacles = []
-    for label, text in (obstacles_data.get("fixed_obstacles") or {}).items():
+    for label, text in fixed.items():
         where = f"fixed_obstacles.{label}"
         fields = dict(_tokens(obstacles_file, where, text, {"RADIUS", "COORD"}))
         if "COORD" not in fields:
@@ -160,8 +181,13 @@ def import_hilsim(obstacles_path: Path, sensors_path: Path, dynamics_path: Path 
             raise InputError(obstacles_file, where, f"RADIUS must be > 0, got {radius:g}")
         obstacles.append({"name": str(label), "kind": "iceberg", "position": _coord(obstacles_file, where, fields["COORD"]),
                           "radius_m": radius})
+    return obstacles
+
+
+def _ships(obstacles_file: str, entries: dict) -> list[dict]:
+    """The thesis's ships (``LENGTH=``, ``SpeedInKnots=``, ``WP=``...) as native ships with AIS on."""
     ships = []
-    for i, (label, text) in enumerate((obstacles_data.get("ships") or {}).items()):
+    for i, (label, text) in enumerate(entries.items()):
         where = f"ships.{label}"
         tokens = _tokens(obstacles_file, where, text, {"LENGTH", "SpeedInKnots", "WP"})
         fields = dict(tokens)
@@ -174,7 +200,11 @@ def import_hilsim(obstacles_path: Path, sensors_path: Path, dynamics_path: Path 
             raise InputError(obstacles_file, where, "LENGTH must be > 0 and SpeedInKnots >= 0")
         ships.append({"name": str(label), "kind": "ship", "length_m": length, "speed_kn": speed, "waypoints": waypoints,
                       "ais": {"enabled": True, "mmsi": MMSI_BASE + i + 1}})
+    return ships
 
+
+def _sensors(sensors_file: str, sensors_data: dict, comments: list[str]) -> tuple[dict, dict]:
+    """Native ``sensors`` and ``tdm`` sections from the thesis's sensor file; its faked-TDM noise goes to comments."""
     sensors: dict = {"lidar": {}, "radar": {}, "ais": {"noise": {}}, "nav": {}}
     tdm: dict = {}
     noise_keys = {f"AIS_{f}_{'sec' if f.endswith('time_constant') else _AIS_UNITS[f]}": _ais_noise_key(f) for f in AIS_NOISE_FIELDS}
@@ -196,39 +226,44 @@ def import_hilsim(obstacles_path: Path, sensors_path: Path, dynamics_path: Path 
     if thesis_fake:
         comments.append("The thesis's faked-TDM radar/LiDAR noise (raysim derives these errors from physics):")
         comments.extend("  " + line for line in thesis_fake)
+    return sensors, tdm
 
-    scenario: dict = {"name": name, "start_time": "2017-06-01T12:00:00Z", "duration_s": float(duration_s), "seed": 7}
-    environment: dict = {}
+
+def _dynamics(dyn_file: str, dynamics_data: dict, scenario: dict, environment: dict, sensors: dict,
+              comments: list[str]) -> list[float] | None:
+    """The thesis's dynamics file into ``scenario`` (origin), ``environment`` and ``sensors``; returns the start position."""
     start = None
-    if dynamics_path is not None:
-        dyn_file = str(dynamics_path)
-        for key, value in dynamics_data.items():
-            if key not in DYNAMICS_KEYS:
-                raise InputError(dyn_file, str(key), "unknown key of the thesis's dynamics file")
-            if isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise InputError(dyn_file, str(key), f"must be a number, got {value!r}")
-        if "start_latitude" in dynamics_data and "start_longitude" in dynamics_data:
-            start = [float(dynamics_data["start_latitude"]), float(dynamics_data["start_longitude"])]
-            if not (-90 <= start[0] <= 90 and -180 <= start[1] <= 180):
-                raise InputError(dyn_file, "start_latitude", "start position out of range")
-            scenario["origin"] = {"lat": start[0], "lon": start[1]}
-        if "wave_height" in dynamics_data:
-            height = float(dynamics_data["wave_height"])
-            environment["sea_state"] = next((i for i, top in enumerate(DOUGLAS_WAVE_HEIGHT_M) if height <= top), 6)
-        if "wind_speed" in dynamics_data:
-            environment["wind_speed_mps"] = float(dynamics_data["wind_speed"])
-        if "wind_direction" in dynamics_data:
-            environment["wind_from_deg"] = float(dynamics_data["wind_direction"]) % 360.0
-        if "gps_frequency" in dynamics_data:
-            sensors["nav"]["rate_hz"] = float(dynamics_data["gps_frequency"])
-        rest = [f"{k}: {dynamics_data[k]}" for k in ("current_speed", "current_direction", "wave_direction", "dt",
-                                                      "mru_frequency", "imu_frequency", "speed_sensor_frequency",
-                                                      "wind_sensor_frequency") if k in dynamics_data]
-        if rest:
-            comments.append("The thesis's dynamics settings without a native key (no currents in raysim yet):")
-            comments.extend("  " + line for line in rest)
-    if environment:
-        scenario["environment"] = environment
+    for key, value in dynamics_data.items():
+        if key not in DYNAMICS_KEYS:
+            raise InputError(dyn_file, str(key), "unknown key of the thesis's dynamics file")
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise InputError(dyn_file, str(key), f"must be a number, got {value!r}")
+    if "start_latitude" in dynamics_data and "start_longitude" in dynamics_data:
+        start = [float(dynamics_data["start_latitude"]), float(dynamics_data["start_longitude"])]
+        if not (-90 <= start[0] <= 90 and -180 <= start[1] <= 180):
+            raise InputError(dyn_file, "start_latitude", "start position out of range")
+        scenario["origin"] = {"lat": start[0], "lon": start[1]}
+    if "wave_height" in dynamics_data:
+        height = float(dynamics_data["wave_height"])
+        environment["sea_state"] = next((i for i, top in enumerate(DOUGLAS_WAVE_HEIGHT_M) if height <= top), 6)
+    if "wind_speed" in dynamics_data:
+        environment["wind_speed_mps"] = float(dynamics_data["wind_speed"])
+    if "wind_direction" in dynamics_data:
+        environment["wind_from_deg"] = float(dynamics_data["wind_direction"]) % 360.0
+    if "gps_frequency" in dynamics_data:
+        sensors["nav"]["rate_hz"] = float(dynamics_data["gps_frequency"])
+    rest = [f"{k}: {dynamics_data[k]}" for k in ("current_speed", "current_direction", "wave_direction", "dt",
+                                                  "mru_frequency", "imu_frequency", "speed_sensor_frequency",
+                                                  "wind_sensor_frequency") if k in dynamics_data]
+    if rest:
+        comments.append("The thesis's dynamics settings without a native key (no currents in raysim yet):")
+        comments.extend("  " + line for line in rest)
+    return start
+
+
+def _own_ship(obstacles_file: str, route: list[list[float]] | None, start: list[float] | None,
+              speed_kn: float) -> dict:
+    """Odin on the given route (starting at the thesis's start position), or lying still at the start."""
     own: dict = {"name": "odin", "length_m": 10.9, "beam_m": 3.5}
     if route:
         waypoints = [[float(a), float(b)] for a, b in route]
@@ -244,13 +279,7 @@ def import_hilsim(obstacles_path: Path, sensors_path: Path, dynamics_path: Path 
         own["heading_deg"] = 0.0
     else:
         raise InputError(obstacles_file, "(own ship)", "no start position: give the dynamics file or a route")
-    scenario["own_ship"] = own
-    scenario["sensors"] = {k: v for k, v in sensors.items() if v and v != {"noise": {}}}
-    if tdm:
-        scenario["tdm"] = tdm
-    scenario["obstacles"] = obstacles
-    scenario["ships"] = ships
-    return scenario, comments
+    return own
 
 
 def scenario_text(scenario: dict, comments: list[str], header: list[str]) -> str:
