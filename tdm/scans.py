@@ -1,0 +1,166 @@
+"""The scan sources of ``tdm run``: every sensor's scans of a recording, in time order.
+
+LiDAR sweeps come from the NPZ files or the Velodyne PCAP, radar sweeps from their NPZ files, AIS
+reports from ``ais/ais.nmea``; :class:`DetectionStream` merges the front ends' detections
+(:mod:`tdm.workers`) with the AIS reports into the one time-ordered stream the trackers consume.
+"""
+
+from __future__ import annotations
+
+import heapq
+from pathlib import Path
+from typing import TYPE_CHECKING, Iterator
+
+from tdm.detections import ReadStats
+from tdm.errors import RecordingError
+from tdm.frames import Mount, OwnshipTrack
+from tdm.frontend.ais import read_ais
+from tdm.frontend.lidar import LidarFrontEndConfig
+from tdm.frontend.radar import RadarFrontEndConfig
+from tdm.io import read_manifest, read_ownship, read_scenario
+from tdm.recording.files import directory_present, is_present, regular_file
+from tdm.recording.manifest import start_time_unix_s as _start_time_unix_s
+from tdm.recording.sweep_files import list_sweeps, sweep_window_s
+from tdm.workers import detections_in_time_order
+
+if TYPE_CHECKING:
+    from tdm.pipeline import TdmConfig
+
+__all__ = ["DetectionStream", "interleaved", "start_time_unix_s"]
+
+#: Defaults of the scan periods when scenario.yaml does not state the rates: the HDL-32E's 10 Hz
+#: (docs/reference.md section 2) and a marine radar's 24 rpm (docs/reference.md section 3 table).
+DEFAULT_LIDAR_ROTATION_HZ = 10.0
+DEFAULT_RADAR_RPM = 24.0
+SECONDS_PER_MINUTE = 60.0
+
+#: Per sensor: (iterator of front-end jobs in time order, scan period in s).
+Jobs = dict[str, tuple[Iterator, float]]
+
+
+def start_time_unix_s(manifest: dict, recording: Path) -> float:
+    """UNIX time of the recording's start, s (:func:`tdm.recording.manifest.start_time_unix_s`)."""
+    return _start_time_unix_s(manifest, recording)
+
+
+def _lidar_jobs(rec: Path, lidar_source: str, manifest: dict, stats: ReadStats) -> Iterator | None:
+    """The LiDAR's front-end jobs (sweep files, or sweeps of the PCAP), or None when it has none."""
+    lidar_dir, pcap = rec / "lidar" / "sweeps", rec / "lidar" / "hdl32e.pcap"
+    source = lidar_source
+    has_npz = directory_present(lidar_dir)  # a file where the directory belongs is an error
+    if source == "auto":
+        source = "npz" if has_npz else "pcap"
+    if source == "npz" and has_npz:
+        return (("lidar", p) for p in list_sweeps(lidar_dir, "lidar", stats))
+    if source == "pcap" and is_present(pcap):
+        from tdm.pcap import check_pcap_header, iter_pcap_sweeps
+
+        check_pcap_header(pcap)
+        sweeps = iter_pcap_sweeps(pcap, start_time_unix_s(manifest, rec), stats,
+                                  window_s=sweep_window_s(float(manifest["duration_s"])))
+        return (("lidar", s) for s in sweeps)
+    if lidar_source != "auto":
+        raise RecordingError(str(pcap if source == "pcap" else lidar_dir), "(file)", f"missing: --lidar-source {source}")
+    return None
+
+
+def _scan_jobs(recording: Path, config: TdmConfig, manifest: dict, scenario: dict, stats: ReadStats) -> Jobs:
+    """Per sensor: (iterator of front-end jobs in time order, scan period in s)."""
+    rec = Path(recording)
+    sensors = scenario.get("sensors") or {}
+    jobs: Jobs = {}
+    lidar_period_s = 1.0 / float((sensors.get("lidar") or {}).get("rotation_hz", DEFAULT_LIDAR_ROTATION_HZ))
+    lidar = _lidar_jobs(rec, config.lidar_source, manifest, stats)
+    if lidar is not None:
+        jobs["lidar"] = (lidar, lidar_period_s)
+    radar_dir = rec / "radar" / "sweeps"
+    if directory_present(radar_dir):
+        radar_period_s = SECONDS_PER_MINUTE / float((sensors.get("radar") or {}).get("rpm", DEFAULT_RADAR_RPM))
+        jobs["radar"] = ((("radar", p) for p in list_sweeps(radar_dir, "radar", stats)), radar_period_s)
+    return jobs
+
+
+def _sweep_limits(manifest: dict, scenario: dict) -> dict[str, tuple[tuple[float, float], dict[str, int] | None]]:
+    """Per sensor: the times its sweeps may hold (s) and the axis lengths scenario.yaml states (radar)."""
+    window_s = sweep_window_s(float(manifest["duration_s"]))
+    radar = (scenario.get("sensors") or {}).get("radar") or {}
+    expected = {axis: int(radar[axis]) for axis in ("spokes", "samples") if radar.get(axis) is not None}
+    return {"lidar": (window_s, None), "radar": (window_s, expected or None)}
+
+
+def interleaved(jobs: Jobs) -> Iterator[tuple[str, object]]:
+    """All sensors' jobs in the order of their scans' expected times (k-th scan at k periods)."""
+    def keyed(name: str, it: Iterator, period_s: float) -> Iterator:
+        for k, job in enumerate(it):
+            yield k * period_s, name, job
+
+    streams = [keyed(name, it, period) for name, (it, period) in jobs.items()]
+    for _, _, job in heapq.merge(*streams, key=lambda item: (item[0], item[1])):
+        yield job
+
+
+class DetectionStream:
+    """Every sensor's detections of a recording in time order: what the trackers consume.
+
+    Also the input of benchmarks that run other trackers on the same detections.
+
+    Parameters
+    ----------
+    recording : Path
+    config : TdmConfig
+    stats : ReadStats
+        Collects counted warnings.
+
+    Attributes
+    ----------
+    ownship : OwnshipTrack
+    nav : dict of (M,) arrays
+        ownship.jsonl columns.
+    reports : list of AisReport
+    static : dict of int to AisStatic
+    """
+
+    def __init__(self, recording: Path, config: TdmConfig, stats: ReadStats, manifest: dict | None = None,
+                 scenario: dict | None = None):
+        rec = Path(recording)
+        manifest = manifest if manifest is not None else read_manifest(rec)
+        scenario = scenario if scenario is not None else read_scenario(rec)
+        self.config, self.stats = config, stats
+        self.nav = read_ownship(rec, stats)
+        self.ownship = OwnshipTrack(self.nav)
+        sensors_cfg = scenario.get("sensors") or {}
+        lidar_cfg = LidarFrontEndConfig.from_scenario(scenario)
+        radar_cfg = RadarFrontEndConfig.from_scenario(scenario)
+        lidar_mount = Mount.from_dict((sensors_cfg.get("lidar") or {}).get("mount"))
+        radar_mount = Mount.from_dict((sensors_cfg.get("radar") or {}).get("mount"))
+        self._initargs = (self.ownship, lidar_mount, lidar_cfg, radar_mount, radar_cfg,
+                          _sweep_limits(manifest, scenario))
+        self._jobs = _scan_jobs(rec, config, manifest, scenario, stats)
+        ais_path = rec / "ais" / "ais.nmea"
+        self.reports, self.static = [], {}
+        has_ais = is_present(ais_path)
+        if has_ais:
+            regular_file(ais_path)  # a directory, a link loop, no permission: an error
+            reports, self.static = read_ais(ais_path, self.ownship.frame, start_time_unix_s(manifest, rec), stats)
+            self.reports = _reports_in_run(reports, float(manifest["duration_s"]), stats)
+        if not self._jobs and not has_ais:
+            raise RecordingError(str(rec), "(directory)", "holds no LiDAR, radar or AIS data to detect targets in")
+
+    def events(self) -> Iterator[tuple[float, str, object]]:
+        """(time s, sensor, Detections or AisReport) in time order (a scan at its last point's time)."""
+        longest_period_s = max((period for _, period in self._jobs.values()), default=0.0)
+        scans = detections_in_time_order(interleaved(self._jobs), longest_period_s, self.config.workers,
+                                         self._initargs, self.stats)
+        return heapq.merge(scans, ((r.time_s, "ais", r) for r in self.reports), key=lambda item: item[0])
+
+
+def _reports_in_run(reports: list, duration_s: float, stats: ReadStats) -> list:
+    """The AIS reports whose times lie within the run (+- the sweeps' margin); the others counted and dropped.
+
+    A receiver clock that jumps (or a TAG block edited by hand) gives times that belong to no epoch.
+    """
+    low, high = sweep_window_s(duration_s)
+    kept = [r for r in reports if low <= r.time_s <= high]
+    if len(kept) < len(reports):
+        stats.count("ais/nmea: message with a time outside the run skipped", len(reports) - len(kept))
+    return kept
