@@ -87,8 +87,8 @@ class ConstantVelocity:
     def poses(self, t_s: np.ndarray) -> Poses:
         t = np.atleast_1d(np.asarray(t_s, dtype=float))
         zeros = np.zeros(t.shape[0])
-        position, yaw = constant_velocity_poses(self.position_m, self.velocity, self.yaw_rad, self.yaw_rate, t)
-        return Poses(position, yaw, zeros, zeros.copy())
+        position = at_constant_rate(self.position_m, self.velocity, t[:, None])
+        return Poses(position, at_constant_rate(self.yaw_rad, self.yaw_rate, t), zeros, zeros.copy())
 
     def velocity_mps(self, t_s: np.ndarray) -> np.ndarray:
         return np.broadcast_to(self.velocity, (np.atleast_1d(t_s).shape[0], 3)).copy()
@@ -364,26 +364,28 @@ class ShipMotion:
 # bank (raysim.scene.poses), which evaluates all bodies of a kind in one pass.
 
 
-def constant_velocity_poses(position_m, velocity_mps, yaw_rad, yaw_rate_rps, t_s: np.ndarray):
-    """Positions ``p0 + t v`` and yaws ``yaw0 + rate t`` of constant-velocity bodies.
+def at_constant_rate(x0, rate, t_s, which=None):
+    """``x0 + rate t``: a position (metres, rate in m/s) or a yaw (radians, rate in rad/s) at times ``t_s``.
 
     Parameters
     ----------
-    position_m, velocity_mps : (3,) or (N, 3) float64
-        Position at t = 0 (metres) and velocity (m/s), one body or one per time.
-    yaw_rad, yaw_rate_rps : float or (N,) float64
-        Yaw at t = 0 (radians) and yaw rate (rad/s).
-    t_s : (N,) float64
+    x0, rate : float or array
+        Value at t = 0 and its rate of change. Without ``which``: one body's, shaped to
+        broadcast with ``t_s`` ((3,) positions against (N, 1) times). With ``which``:
+        tables of K bodies, (K,) or (3, K), the body in the last axis.
+    t_s : array
         Times, seconds.
+    which : (N,) int, optional
+        The body of each time (a column of the tables).
 
     Returns
     -------
-    position : (N, 3) float64
-        Metres.
-    yaw : (N,) float64
-        Radians.
+    array
+        The broadcast shape ((N,) or (3, N) with ``which``), float64.
     """
-    return position_m + t_s[:, None] * velocity_mps, yaw_rad + yaw_rate_rps * t_s
+    v = (rate if which is None else np.take(rate, which, axis=-1)) * t_s
+    v += x0 if which is None else np.take(x0, which, axis=-1)
+    return v
 
 
 def track_index(t_s: np.ndarray, dt_s, last, i_max) -> tuple[np.ndarray, np.ndarray]:
@@ -412,9 +414,15 @@ def track_index(t_s: np.ndarray, dt_s, last, i_max) -> tuple[np.ndarray, np.ndar
     return i, u - i
 
 
-def lerp(a: np.ndarray, b: np.ndarray, f: np.ndarray) -> np.ndarray:
-    """Linear interpolation ``a + (b - a) f`` (any broadcastable shapes)."""
-    return a + (b - a) * f
+def lerp(a: np.ndarray, b: np.ndarray, f: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+    """Linear interpolation ``a + (b - a) f`` (``b - a`` of the result's shape; ``f`` broadcast).
+
+    ``out`` (may be ``b``) receives the result; a new array if None.
+    """
+    v = np.subtract(b, a, out=out)
+    v *= f
+    v += a
+    return v
 
 
 def wave_angles(params: np.ndarray, t_s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

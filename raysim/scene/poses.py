@@ -6,7 +6,7 @@ the motions of known kinds (exactly :class:`~raysim.motion.ConstantVelocity`,
 :class:`~raysim.motion.SampledTrack`, :class:`~raysim.motion.ShipMotion` of a
 ``SampledTrack`` with or without :class:`~raysim.motion.WaveMotion`) into
 tables once, and evaluates all pairs of a kind in one vectorised pass with
-the motions' own kernels (:func:`raysim.motion.constant_velocity_poses`,
+the motions' own kernels (:func:`raysim.motion.at_constant_rate`,
 :func:`~raysim.motion.track_index`, :func:`~raysim.motion.lerp`,
 :func:`~raysim.motion.wave_angles`): the same numbers as the motions'
 ``poses``. Any other motion is asked object by object.
@@ -18,8 +18,8 @@ from typing import Sequence
 
 import numpy as np
 
-from raysim.motion import (ConstantVelocity, Motion, SampledTrack, ShipMotion, WaveMotion, constant_velocity_poses,
-                           lerp, track_index, wave_angles)
+from raysim.motion import (ConstantVelocity, Motion, SampledTrack, ShipMotion, WaveMotion, at_constant_rate, lerp,
+                           track_index, wave_angles)
 from raysim.scene.geometry import SPHERE_PAD_M
 
 _MAX_POSE_SAMPLES = 16
@@ -56,8 +56,8 @@ class PoseBank:
         self.motions = list(motions)
         self.kind = np.full(k, _KIND_OTHER, dtype=np.int8)
         self.planar = np.zeros(k, dtype=bool)  # pitch and roll are always zero
-        self.cv_position = np.zeros((k, 3))
-        self.cv_velocity = np.zeros((k, 3))
+        self.cv_position = np.zeros((3, k))
+        self.cv_velocity = np.zeros((3, k))
         self.cv_yaw = np.zeros(k)
         self.cv_yaw_rate = np.zeros(k)
         self.tr_base = np.zeros(k, dtype=np.int64)  # first sample of each track in tr_samples
@@ -71,7 +71,7 @@ class PoseBank:
             if type(m) is ConstantVelocity:
                 self.kind[i] = _KIND_CONSTANT_VELOCITY
                 self.planar[i] = True
-                self.cv_position[i], self.cv_velocity[i] = m.position_m, m.velocity
+                self.cv_position[:, i], self.cv_velocity[:, i] = m.position_m, m.velocity
                 self.cv_yaw[i], self.cv_yaw_rate[i] = m.yaw_rad, m.yaw_rate
                 continue
             track, waves = _packed_track(m)
@@ -134,16 +134,15 @@ class PoseBank:
 
     def _constant_velocity(self, out: Pose, sel: slice | np.ndarray, lab: np.ndarray, tt: np.ndarray) -> None:
         """Fill pairs ``sel`` of ``out`` for constant-velocity objects ``lab`` (P,) at times ``tt`` (P,)."""
-        position, yaw = constant_velocity_poses(np.take(self.cv_position, lab, axis=0), np.take(self.cv_velocity, lab, axis=0),
-                                                np.take(self.cv_yaw, lab), np.take(self.cv_yaw_rate, lab), tt)
-        out[0][:, sel] = position.T
-        out[1][sel] = yaw
+        out[0][:, sel] = at_constant_rate(self.cv_position, self.cv_velocity, tt, which=lab)
+        out[1][sel] = at_constant_rate(self.cv_yaw, self.cv_yaw_rate, tt, which=lab)
 
     def _tracks(self, out: Pose, sel: slice | np.ndarray, lab: np.ndarray, tt: np.ndarray, one: bool) -> None:
         """Fill pairs ``sel`` of ``out`` for sampled-track objects (``one``: ``lab`` is one label for all)."""
         i, f = track_index(tt, np.take(self.tr_dt, lab), np.take(self.tr_last, lab), np.take(self.tr_imax, lab))
         i += np.take(self.tr_base, lab)
-        v = lerp(np.take(self.tr_samples, i, axis=1), np.take(self.tr_samples, i + 1, axis=1), f)  # (6, P)
+        b = np.take(self.tr_samples, i + 1, axis=1)
+        v = lerp(np.take(self.tr_samples, i, axis=1), b, f, out=b)  # (6, P)
         if one:
             w = slice(None) if self.has_waves[lab[0]] else None
             wp = self.waves[:, lab[0] : lab[0] + 1]
