@@ -80,13 +80,14 @@ Position covariance (ENU, m^2), a sum of independent terms:
 * navigation: ``s_nav`` the own-ship position error per axis, shared by every point.
 
 ``s_r > 0`` keeps P positive definite for any cluster, even a single point.
+
+The settings are :class:`LidarFrontEndConfig` (:mod:`tdm.frontend.lidar_config`), importable from here too.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Literal
 
 import numpy as np
 from scipy.sparse import csr_matrix
@@ -95,177 +96,25 @@ from scipy.spatial import cKDTree
 
 from tdm.detections import Detections
 from tdm.frames import Mount, OwnshipTrack
+from tdm.frontend.lidar_config import (HDL32E_FIRING_CYCLE_S, LINK_WINDOW_CYCLES, LidarFrontEndConfig,
+                                       lidar_mount_from_scenario)
 
-#: HDL-32E firing cycle: 32 firings of 1.152 us + 9.216 us recharge, s (docs/reference.md section 2).
-HDL32E_FIRING_CYCLE_S = 46.08e-6
-#: Range-image neighbours lie at most two azimuth steps (firing cycles) apart, so they are fired
-#: within this many cycles of each other; points a revolution apart (at the seam) are not linked.
-LINK_WINDOW_CYCLES = 3
+__all__ = ["HDL32E_FIRING_CYCLE_S", "LINK_WINDOW_CYCLES", "LidarFrontEndConfig", "lidar_clusters", "lidar_detections",
+           "lidar_mount_from_scenario"]
 
-
-@dataclass(frozen=True)
-class LidarFrontEndConfig:
-    """Settings of the LiDAR front end (module docstring for how each is used).
-
-    Attributes
-    ----------
-    ownship_length_m, ownship_beam_m : float
-        Own ship's length overall and beam, m. Default: Odin, the thesis's USV (10.9 x 3.5 m,
-        scenarios/busy_open_sea.yaml).
-    ownship_margin_m : float
-        Padding of the own-ship box on every side, m (default 0.5: covers fenders, rails and
-        the range noise; nothing nearer than that to the hull is a target to track).
-    ownship_centre_x_m : float
-        Body-frame x of the middle of the hull, m (0: the body origin is midships, as in the
-        recordings' meshes).
-    range_min_m, range_max_m : float
-        Returns outside this range are dropped, m. Defaults: 0.1 m (drivers cut at 0.1-0.9 m)
-        and 100 m (HDL-32E rated range), docs/reference.md section 2.
-    min_height_m : float
-        Points whose ENU z is below this are sea or foam, m. The sea surface is the plane
-        z = 0 (waves move the own ship, not the sea's returns), and foam returns lie within
-        centimetres of it; 0.5 m keeps clear of them and of the own ship's heave error while
-        keeping all but the lowest part of a target.
-    voxel_m : float
-        Side of the horizontal voxels (pillars) the points are binned into before clustering,
-        m. 0.25 m, well under the tolerance, so clusters match raw-point clustering to within
-        a voxel while a close iceberg's ~2000 points become a few hundred voxels.
-    cluster_tolerance_m : float
-        Euclidean clustering distance on the horizontal plane, m (PCL/Autoware default 0.7 m,
-        docs/reference.md section 5).
-    ring_link_angle_deg : float
-        Minimum angle beta for joining points of nearby rings, deg (10 deg: Bogoslavskyi &
-        Stachniss 2016, the depth_clustering default).
-    ring_link_max_step : int
-        Rings up to this many apart are linked (2: bridges one ring without a return).
-    min_points, max_points : int, int or None
-        Clusters with fewer (more) raw points are dropped. 10 is the PCL/Autoware minimum
-        (docs/reference.md section 5, counted there on voxels). No maximum by default: the
-        Autoware maximum of 1000 removes buildings on land, but at sea a big cluster is a big
-        target (a close iceberg gives ~2000 points).
-    min_surface_fraction : float
-        Clusters in which fewer than this fraction of the points have a same-surface
-        neighbour along their own ring are dropped as weather. A solid surface is hit by
-        successive firings of a laser; backscatter from rain and fog drops (docs/reference.md
-        section 2) is not: measured here, 0-3 % of the points of rain clusters
-        (rough_sea_rain) against 92-100 % of those of iceberg and ship clusters. 0.5 lies
-        well between.
-    range_sigma_m : float
-        Range accuracy, 1 sigma, m (HDL-32E: < 2 cm at 25 m, docs/reference.md section 2, unverified).
-    rotation_hz : float
-        Head rotation rate, Hz (HDL-32E default 10 Hz); sets the azimuth step.
-    beam_divergence_mrad : float
-        Full beam divergence, mrad (no official HDL-32E figure; simulators use about 3 mrad,
-        docs/reference.md section 2).
-    nav_position_sigma_m : float
-        Own-ship position error, 1 sigma per axis, m (GNSS noise and bias; default 0.5 m, a
-        typical uncorrected GNSS fix, unverified; :meth:`from_scenario` reads the recording's).
-    nav_heading_sigma_deg : float
-        Own-ship heading error, 1 sigma, deg (default 0.1 deg, a GNSS compass class,
-        unverified; :meth:`from_scenario` reads the recording's).
-    centre : {"outline", "mean"}
-        How a cluster's position is estimated (module docstring, step 7). "outline" (default):
-        the midpoint of the two points farthest left and right across the line of sight;
-        "mean": the mean of the points, biased toward the sensor.
-    deskew : bool
-        Map each point with the pose at its own time (True) or every point with the pose at
-        the scan's first point (False, for comparison only).
-    deskew_step_s : float
-        The pose is computed on a grid of this step and each point takes the nearest node
-        (0: each point its own pose). 0.25 ms: a point is at most 0.125 ms off its own time,
-        in which a boat turning at 20 deg/s turns 0.0025 deg (4 mm at 100 m) and moves 1.3 mm
-        at 10 m/s, well under the range accuracy; about 8 times fewer pose evaluations than
-        points.
-    """
-
-    ownship_length_m: float = 10.9
-    ownship_beam_m: float = 3.5
-    ownship_margin_m: float = 0.5
-    ownship_centre_x_m: float = 0.0
-    range_min_m: float = 0.1
-    range_max_m: float = 100.0
-    min_height_m: float = 0.5
-    voxel_m: float = 0.25
-    cluster_tolerance_m: float = 0.7
-    ring_link_angle_deg: float = 10.0
-    ring_link_max_step: int = 2
-    min_points: int = 10
-    max_points: int | None = None
-    min_surface_fraction: float = 0.5
-    range_sigma_m: float = 0.02
-    rotation_hz: float = 10.0
-    beam_divergence_mrad: float = 3.0
-    nav_position_sigma_m: float = 0.5
-    nav_heading_sigma_deg: float = 0.1
-    centre: Literal["outline", "mean"] = "outline"
-    deskew: bool = True
-    deskew_step_s: float = 2.5e-4
-
-    def __post_init__(self):
-        def check(ok: bool, name: str, what: str) -> None:
-            if not ok:
-                raise ValueError(f"LidarFrontEndConfig.{name} must be {what}, got {getattr(self, name)!r}")
-
-        for name in ("ownship_length_m", "ownship_beam_m", "range_max_m", "voxel_m", "cluster_tolerance_m",
-                     "range_sigma_m", "rotation_hz"):
-            check(getattr(self, name) > 0, name, "> 0")
-        for name in ("ownship_margin_m", "range_min_m", "deskew_step_s", "beam_divergence_mrad",
-                     "nav_position_sigma_m", "nav_heading_sigma_deg", "ring_link_max_step"):
-            check(getattr(self, name) >= 0, name, ">= 0")
-        check(self.min_points >= 1, "min_points", ">= 1")
-        check(self.max_points is None or self.max_points >= self.min_points, "max_points", "None or >= min_points")
-        check(0 <= self.min_surface_fraction <= 1, "min_surface_fraction", "in [0, 1]")
-        check(0 <= self.ring_link_angle_deg < 90, "ring_link_angle_deg", "in [0, 90)")
-        check(self.centre in ("outline", "mean"), "centre", "'outline' or 'mean'")
-
-    @classmethod
-    def from_scenario(cls, scenario: dict, **overrides) -> "LidarFrontEndConfig":
-        """The configuration for a recording, from its resolved ``scenario.yaml``.
-
-        Reads ``own_ship.length_m`` and ``beam_m``; ``sensors.lidar.range_min_m``,
-        ``range_max_m``, ``rotation_hz`` and ``beam_divergence_mrad``; and, when present,
-        ``sensors.nav`` position and heading noise and bias (combined as root sum of
-        squares). Missing keys keep the defaults. The LiDAR's mount is not part of this
-        configuration: :func:`lidar_mount_from_scenario` reads it.
-
-        Parameters
-        ----------
-        scenario : dict
-            The parsed ``scenario.yaml`` of a recording.
-        **overrides
-            Fields to set explicitly (win over the scenario).
-        """
-        values: dict = {}
-        own = scenario.get("own_ship") or {}
-        if own.get("length_m") is not None:
-            values["ownship_length_m"] = float(own["length_m"])
-        if own.get("beam_m") is not None:
-            values["ownship_beam_m"] = float(own["beam_m"])
-        sensors = scenario.get("sensors") or {}
-        lidar = sensors.get("lidar") or {}
-        for key, name in (("range_min_m", "range_min_m"), ("range_max_m", "range_max_m"),
-                          ("rotation_hz", "rotation_hz"), ("beam_divergence_mrad", "beam_divergence_mrad")):
-            if lidar.get(key) is not None:
-                values[name] = float(lidar[key])
-        nav = sensors.get("nav") or {}
-        if nav.get("enabled", True) and any(k in nav for k in ("position_noise_m", "position_bias_m")):
-            values["nav_position_sigma_m"] = math.hypot(float(nav.get("position_noise_m", 0.0)),
-                                                        float(nav.get("position_bias_m", 0.0)))
-        if nav.get("enabled", True) and any(k in nav for k in ("heading_noise_deg", "heading_bias_deg")):
-            values["nav_heading_sigma_deg"] = math.hypot(float(nav.get("heading_noise_deg", 0.0)),
-                                                         float(nav.get("heading_bias_deg", 0.0)))
-        values.update(overrides)
-        return cls(**values)
-
-    @property
-    def azimuth_step_rad(self) -> float:
-        """Azimuth between successive firing cycles, rad (0.1659 deg at 10 Hz)."""
-        return 2.0 * math.pi * self.rotation_hz * HDL32E_FIRING_CYCLE_S
-
-
-def lidar_mount_from_scenario(scenario: dict) -> Mount:
-    """The LiDAR's mount (``sensors.lidar.mount``) of a resolved ``scenario.yaml`` dict."""
-    return Mount.from_dict(((scenario.get("sensors") or {}).get("lidar") or {}).get("mount"))
+#: Range-image neighbours lie within this many azimuth steps of each other (a firing cycle apart,
+#: or two when one firing had no return).
+NEIGHBOUR_AZIMUTH_STEPS = 2
+#: Spare azimuth bins per ring in the range image's keys, beyond one revolution (the bins of a
+#: ring stay apart from the next ring's whatever the rounding of the azimuths).
+_SPARE_AZIMUTH_BINS = 8
+#: Variance of a uniform distribution over a width w: w^2 / 12 (footprint box, azimuth step).
+UNIFORM_VARIANCE_DIVISOR = 12.0
+#: Variance per axis of a uniform disc of diameter d: d^2 / 16 (beam divergence).
+DISC_VARIANCE_DIVISOR = 16.0
+RAD_PER_MRAD = 1e-3
+#: A mount rotation this close to the identity is taken as none (the own-ship test skips the product).
+_IDENTITY_ATOL = 1e-12
 
 
 def _range_image_links(ring: np.ndarray, points_m: np.ndarray, range_m: np.ndarray, t_s: np.ndarray,
@@ -308,7 +157,7 @@ def _range_image_links(ring: np.ndarray, points_m: np.ndarray, range_m: np.ndarr
     if n < 2:
         return np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.intp), on_surface
     step_rad = config.azimuth_step_rad
-    n_bins = int(math.ceil(2.0 * math.pi / step_rad)) + 8
+    n_bins = int(math.ceil(2.0 * math.pi / step_rad)) + _SPARE_AZIMUTH_BINS
     azimuth_bin = ((np.arctan2(points_m[:, 1], points_m[:, 0]) + math.pi) / step_rad).astype(np.int64)
     key = ring * n_bins + azimuth_bin
     order = np.argsort(key)
@@ -324,7 +173,7 @@ def _range_image_links(ring: np.ndarray, points_m: np.ndarray, range_m: np.ndarr
         return (r2i * r2j - dot * dot > tan2 * gap * gap) & (np.abs(t_s[i] - t_s[j]) <= window_s)
 
     # along each ring: successive points in the sorted order
-    close = np.nonzero(sorted_key[1:] - sorted_key[:-1] <= 2)[0]
+    close = np.nonzero(sorted_key[1:] - sorted_key[:-1] <= NEIGHBOUR_AZIMUTH_STEPS)[0]
     i, j = order[close], order[close + 1]
     linked = same_surface(i, j)
     firsts, seconds = [i[linked]], [j[linked]]
@@ -338,7 +187,7 @@ def _range_image_links(ring: np.ndarray, points_m: np.ndarray, range_m: np.ndarr
         hi = order[np.minimum(pos, n - 1)]
         d_lo = np.abs(key[lo] - query)  # in azimuth bins when in the right ring
         d_hi = np.abs(key[hi] - query)
-        i = np.nonzero(np.minimum(d_lo, d_hi) <= 2)[0]
+        i = np.nonzero(np.minimum(d_lo, d_hi) <= NEIGHBOUR_AZIMUTH_STEPS)[0]
         j = np.where(d_hi[i] < d_lo[i], hi[i], lo[i])
         linked = same_surface(i, j)
         firsts.append(i[linked])
@@ -395,67 +244,22 @@ def lidar_clusters(sweep: dict[str, np.ndarray], track: OwnshipTrack, mount: Mou
     time_s = np.asarray(sweep["time"], dtype=np.float64)
     scan_time_s = float(time_s.min()) if time_s.size else math.nan
     x, y, z = (np.asarray(sweep[k]) for k in ("x", "y", "z"))
-
-    # 1. own ship: a body-frame column, tested in the sweep's own precision (float32)
-    rot = mount.rotation()
-    dx = mount.x_m - config.ownship_centre_x_m
-    if np.allclose(rot, np.eye(3), rtol=0.0, atol=1e-12):
-        body_x, body_y = x + dx, y + mount.y_m
-    else:
-        body_x = rot[0, 0] * x + rot[0, 1] * y + rot[0, 2] * z + dx
-        body_y = rot[1, 0] * x + rot[1, 1] * y + rot[1, 2] * z + mount.y_m
-    half_length = 0.5 * config.ownship_length_m + config.ownship_margin_m
-    half_beam = 0.5 * config.ownship_beam_m + config.ownship_margin_m
-    idx = np.nonzero((np.abs(body_x) > half_length) | (np.abs(body_y) > half_beam))[0]
-
-    # 2. bad returns
-    sensor_points = np.stack([x[idx], y[idx], z[idx]], axis=1).astype(np.float64)
-    t = time_s[idx]
-    range_m = np.sqrt(np.einsum("ij,ij->i", sensor_points, sensor_points))
-    ok = np.isfinite(range_m) & np.isfinite(t) & (range_m > 0)
-    ok &= (range_m >= config.range_min_m) & (range_m <= config.range_max_m)
-    idx, sensor_points, t, range_m = idx[ok], sensor_points[ok], t[ok], range_m[ok]
+    idx, sensor_points, t, range_m = _good_returns(_off_ship(x, y, z, mount, config), x, y, z, time_s, config)
     if idx.size == 0:
         return _nothing(scan_time_s)
-
     # 3. deskew: every point with the pose at its own time
     enu = _sensor_to_enu(track, sensor_points, t if config.deskew else np.full_like(t, scan_time_s), mount,
                          config.deskew_step_s)
-
     # 4. sea and foam
     above = enu[:, 2] >= config.min_height_m
     if not above.any():
         return _nothing(scan_time_s)
     enu, sensor_points, t, range_m, idx = enu[above], sensor_points[above], t[above], range_m[above], idx[above]
-
-    # 5. horizontal voxels (pillars), represented by the mean of their points
-    cell = np.floor(enu[:, :2] / config.voxel_m).astype(np.int64)
-    cell -= cell.min(axis=0)
-    voxel_key = cell[:, 0] * (int(cell[:, 1].max()) + 1) + cell[:, 1]
-    _, inverse, voxel_count = np.unique(voxel_key, return_inverse=True, return_counts=True)
-    inverse = inverse.reshape(-1)
-    n_voxels = voxel_count.shape[0]
-    centres = np.stack([np.bincount(inverse, enu[:, 0], n_voxels), np.bincount(inverse, enu[:, 1], n_voxels)],
-                       axis=1) / voxel_count[:, None]
-
-    # 6. graph on voxels: Euclidean pairs + ring links, then connected components
-    pairs = cKDTree(centres).query_pairs(config.cluster_tolerance_m, output_type="ndarray")
+    # 5., 6. voxels, their graph and its clusters; clusters of too few points or of weather dropped
+    inverse, centres = _voxels(enu, config.voxel_m)
     ring = np.asarray(sweep["ring"])[idx].astype(np.int64)
-    link_i, link_j, on_surface = _range_image_links(ring, sensor_points, range_m, t, config)
-    link_i, link_j = inverse[link_i], inverse[link_j]
-    between = link_i != link_j
-    rows = np.concatenate([pairs[:, 0], link_i[between]])
-    cols = np.concatenate([pairs[:, 1], link_j[between]])
-    graph = csr_matrix((np.ones(rows.shape[0]), (rows, cols)), shape=(n_voxels, n_voxels))
-    _, voxel_label = connected_components(graph, directed=False)
-    label = voxel_label[inverse]
-
-    # cluster filters: size in raw points, and echoes from surfaces rather than weather
-    counts = np.bincount(label)
-    good = counts >= config.min_points
-    if config.max_points is not None:
-        good &= counts <= config.max_points
-    good &= np.bincount(label, on_surface, counts.shape[0]) >= config.min_surface_fraction * counts
+    label, on_surface = _cluster_labels(inverse, centres, ring, sensor_points, range_m, t, config)
+    good, counts = _kept_clusters(label, on_surface, config)
     if not good.any():
         return _nothing(scan_time_s)
     new_id = np.cumsum(good) - 1
@@ -464,8 +268,120 @@ def lidar_clusters(sweep: dict[str, np.ndarray], track: OwnshipTrack, mount: Mou
     enu, t, idx = enu[member], t[member], idx[member]
     k = int(good.sum())
     n_cells = counts[good].astype(np.int64)
+    # 7. per-cluster statistics; the sensor at each cluster's time, and the line of sight to the points' mean
+    fp = _footprints(enu, t, label, n_cells)
+    sensor_enu = track.sensor_to_enu(np.zeros((k, 3)), fp.mean_t if config.deskew else np.full(k, scan_time_s), mount)
+    if config.centre == "outline":
+        centre_e, centre_n = _outline_centres(enu, label, n_cells, fp, sensor_enu)
+    else:
+        centre_e, centre_n = fp.mean_e, fp.mean_n
+    los_e = centre_e - sensor_enu[:, 0]
+    los_n = centre_n - sensor_enu[:, 1]
+    horizontal_range_m = np.hypot(los_e, los_n)
+    detections = Detections(
+        sensor="lidar",
+        scan_time_s=scan_time_s,
+        time_s=fp.mean_t,
+        position_m=np.stack([centre_e, centre_n], axis=1),
+        position_cov_m2=_cluster_cov(fp, los_e, los_n, horizontal_range_m, config),
+        cross_section_m2=fp.length_m * fp.width_m,
+        length_m=fp.length_m,
+        width_m=fp.width_m,
+        orientation_deg=np.mod(90.0 - np.degrees(fp.phi_long), 180.0),
+        height_m=fp.height_m,
+        n_cells=n_cells,
+        range_m=horizontal_range_m,
+    )
+    return detections, idx, label
 
-    # 7. per-cluster statistics (vectorised over clusters)
+
+def _off_ship(x: np.ndarray, y: np.ndarray, z: np.ndarray, mount: Mount, config: LidarFrontEndConfig) -> np.ndarray:
+    """Indices of the points outside the own ship's body-frame column (step 1), in the sweep's own
+    precision (float32)."""
+    rot = mount.rotation()
+    dx = mount.x_m - config.ownship_centre_x_m
+    if np.allclose(rot, np.eye(3), rtol=0.0, atol=_IDENTITY_ATOL):
+        body_x, body_y = x + dx, y + mount.y_m
+    else:
+        body_x = rot[0, 0] * x + rot[0, 1] * y + rot[0, 2] * z + dx
+        body_y = rot[1, 0] * x + rot[1, 1] * y + rot[1, 2] * z + mount.y_m
+    half_length = 0.5 * config.ownship_length_m + config.ownship_margin_m
+    half_beam = 0.5 * config.ownship_beam_m + config.ownship_margin_m
+    return np.nonzero((np.abs(body_x) > half_length) | (np.abs(body_y) > half_beam))[0]
+
+
+def _good_returns(idx: np.ndarray, x: np.ndarray, y: np.ndarray, z: np.ndarray, time_s: np.ndarray,
+                  config: LidarFrontEndConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Of the points ``idx``, those with a finite return within the range limits (step 2): their
+    indices, sensor-frame points (N, 3) m, times s and ranges m."""
+    sensor_points = np.stack([x[idx], y[idx], z[idx]], axis=1).astype(np.float64)
+    t = time_s[idx]
+    range_m = np.sqrt(np.einsum("ij,ij->i", sensor_points, sensor_points))
+    ok = np.isfinite(range_m) & np.isfinite(t) & (range_m > 0)
+    ok &= (range_m >= config.range_min_m) & (range_m <= config.range_max_m)
+    return idx[ok], sensor_points[ok], t[ok], range_m[ok]
+
+
+def _voxels(enu: np.ndarray, voxel_m: float) -> tuple[np.ndarray, np.ndarray]:
+    """Horizontal voxels (pillars) of the points (step 5): each point's voxel, and the voxels' mean
+    points (V, 2), m."""
+    cell = np.floor(enu[:, :2] / voxel_m).astype(np.int64)
+    cell -= cell.min(axis=0)
+    voxel_key = cell[:, 0] * (int(cell[:, 1].max()) + 1) + cell[:, 1]
+    _, inverse, voxel_count = np.unique(voxel_key, return_inverse=True, return_counts=True)
+    inverse = inverse.reshape(-1)
+    n_voxels = voxel_count.shape[0]
+    centres = np.stack([np.bincount(inverse, enu[:, 0], n_voxels), np.bincount(inverse, enu[:, 1], n_voxels)],
+                       axis=1) / voxel_count[:, None]
+    return inverse, centres
+
+
+def _cluster_labels(inverse: np.ndarray, centres: np.ndarray, ring: np.ndarray, sensor_points: np.ndarray,
+                    range_m: np.ndarray, t: np.ndarray, config: LidarFrontEndConfig) -> tuple[np.ndarray, np.ndarray]:
+    """Each point's cluster (step 6: Euclidean pairs of voxels + ring links, connected components), and
+    whether it lies on a surface along its ring."""
+    n_voxels = centres.shape[0]
+    pairs = cKDTree(centres).query_pairs(config.cluster_tolerance_m, output_type="ndarray")
+    link_i, link_j, on_surface = _range_image_links(ring, sensor_points, range_m, t, config)
+    link_i, link_j = inverse[link_i], inverse[link_j]
+    between = link_i != link_j
+    rows = np.concatenate([pairs[:, 0], link_i[between]])
+    cols = np.concatenate([pairs[:, 1], link_j[between]])
+    graph = csr_matrix((np.ones(rows.shape[0]), (rows, cols)), shape=(n_voxels, n_voxels))
+    _, voxel_label = connected_components(graph, directed=False)
+    return voxel_label[inverse], on_surface
+
+
+def _kept_clusters(label: np.ndarray, on_surface: np.ndarray, config: LidarFrontEndConfig
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """(C,) bool clusters kept (size in raw points, echoes from surfaces rather than weather) and (C,)
+    their point counts."""
+    counts = np.bincount(label)
+    good = counts >= config.min_points
+    if config.max_points is not None:
+        good &= counts <= config.max_points
+    good &= np.bincount(label, on_surface, counts.shape[0]) >= config.min_surface_fraction * counts
+    return good, counts
+
+
+@dataclass
+class _Footprint:
+    """Per cluster (k,): mean point (m), mean time (s), height (m), footprint box (m) and the ENU angle
+    of its long side (rad); each cluster's first position in the points sorted by cluster."""
+
+    mean_e: np.ndarray
+    mean_n: np.ndarray
+    mean_t: np.ndarray
+    height_m: np.ndarray
+    length_m: np.ndarray
+    width_m: np.ndarray
+    phi_long: np.ndarray
+    starts: np.ndarray
+
+
+def _footprints(enu: np.ndarray, t: np.ndarray, label: np.ndarray, n_cells: np.ndarray) -> _Footprint:
+    """Mean, height and PCA footprint box of every cluster (step 7), vectorised over clusters."""
+    k = n_cells.shape[0]
     order = np.argsort(label, kind="stable")
     starts = np.concatenate([[0], np.cumsum(n_cells)[:-1]])
     mean_e = np.bincount(label, enu[:, 0], k) / n_cells
@@ -487,53 +403,42 @@ def lidar_clusters(sweep: dict[str, np.ndarray], track: OwnshipTrack, mount: Mou
     length_m = np.where(swap, extent_across, extent_along)
     width_m = np.where(swap, extent_along, extent_across)
     phi_long = np.where(swap, phi + 0.5 * np.pi, phi)
-    orientation_deg = np.mod(90.0 - np.degrees(phi_long), 180.0)
+    return _Footprint(mean_e, mean_n, mean_t, height_m, length_m, width_m, phi_long, starts)
 
-    # the sensor at each cluster's time, and the line of sight to the points' mean
-    sensor_enu = track.sensor_to_enu(np.zeros((k, 3)), mean_t if config.deskew else np.full(k, scan_time_s), mount)
-    if config.centre == "outline":
-        los_angle = np.arctan2(mean_n - sensor_enu[:, 1], mean_e - sensor_enu[:, 0])
-        u_e, u_n = np.cos(los_angle), np.sin(los_angle)
-        rel_e = enu[:, 0] - sensor_enu[label, 0]
-        rel_n = enu[:, 1] - sensor_enu[label, 1]
-        depth = rel_e * u_e[label] + rel_n * u_n[label]
-        cross = -rel_e * u_n[label] + rel_n * u_e[label]
-        by_cross = np.lexsort((cross, label))
-        left = by_cross[starts]
-        right = by_cross[starts + n_cells - 1]
-        centre_depth = 0.5 * (depth[left] + depth[right])
-        centre_cross = 0.5 * (cross[left] + cross[right])
-        centre_e = sensor_enu[:, 0] + centre_depth * u_e - centre_cross * u_n
-        centre_n = sensor_enu[:, 1] + centre_depth * u_n + centre_cross * u_e
-    else:
-        centre_e, centre_n = mean_e, mean_n
-    los_e = centre_e - sensor_enu[:, 0]
-    los_n = centre_n - sensor_enu[:, 1]
-    horizontal_range_m = np.hypot(los_e, los_n)
 
-    # covariance (module docstring)
-    cov = _axes_cov(phi_long, length_m ** 2 / 12.0, width_m ** 2 / 12.0)
-    cross_var = horizontal_range_m ** 2 * (config.azimuth_step_rad ** 2 / 12.0
-                                           + (1e-3 * config.beam_divergence_mrad) ** 2 / 16.0
+def _outline_centres(enu: np.ndarray, label: np.ndarray, n_cells: np.ndarray, fp: _Footprint,
+                     sensor_enu: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(k,) east and north of each cluster's centre, m: the midpoint of its two outline points, farthest
+    left and right across the line of sight from the sensor to the points' mean (step 7)."""
+    los_angle = np.arctan2(fp.mean_n - sensor_enu[:, 1], fp.mean_e - sensor_enu[:, 0])
+    u_e, u_n = np.cos(los_angle), np.sin(los_angle)
+    rel_e = enu[:, 0] - sensor_enu[label, 0]
+    rel_n = enu[:, 1] - sensor_enu[label, 1]
+    depth = rel_e * u_e[label] + rel_n * u_n[label]
+    cross = -rel_e * u_n[label] + rel_n * u_e[label]
+    by_cross = np.lexsort((cross, label))
+    left = by_cross[fp.starts]
+    right = by_cross[fp.starts + n_cells - 1]
+    centre_depth = 0.5 * (depth[left] + depth[right])
+    centre_cross = 0.5 * (cross[left] + cross[right])
+    centre_e = sensor_enu[:, 0] + centre_depth * u_e - centre_cross * u_n
+    centre_n = sensor_enu[:, 1] + centre_depth * u_n + centre_cross * u_e
+    return centre_e, centre_n
+
+
+def _cluster_cov(fp: _Footprint, los_e: np.ndarray, los_n: np.ndarray, horizontal_range_m: np.ndarray,
+                 config: LidarFrontEndConfig) -> np.ndarray:
+    """(k, 2, 2) ENU position covariance, m^2: footprint spread + sensor + navigation (module docstring)."""
+    k = fp.length_m.shape[0]
+    cov = _axes_cov(fp.phi_long, fp.length_m ** 2 / UNIFORM_VARIANCE_DIVISOR,
+                    fp.width_m ** 2 / UNIFORM_VARIANCE_DIVISOR)
+    cross_var = horizontal_range_m ** 2 * (config.azimuth_step_rad ** 2 / UNIFORM_VARIANCE_DIVISOR
+                                           + (RAD_PER_MRAD * config.beam_divergence_mrad) ** 2
+                                           / DISC_VARIANCE_DIVISOR
                                            + math.radians(config.nav_heading_sigma_deg) ** 2)
     cov += _axes_cov(np.arctan2(los_n, los_e), np.full(k, config.range_sigma_m ** 2), cross_var)
     cov += config.nav_position_sigma_m ** 2 * np.eye(2)
-
-    detections = Detections(
-        sensor="lidar",
-        scan_time_s=scan_time_s,
-        time_s=mean_t,
-        position_m=np.stack([centre_e, centre_n], axis=1),
-        position_cov_m2=cov,
-        cross_section_m2=length_m * width_m,
-        length_m=length_m,
-        width_m=width_m,
-        orientation_deg=orientation_deg,
-        height_m=height_m,
-        n_cells=n_cells,
-        range_m=horizontal_range_m,
-    )
-    return detections, idx, label
+    return cov
 
 
 def _sensor_to_enu(track: OwnshipTrack, points_sensor_m: np.ndarray, t_s: np.ndarray, mount: Mount,
