@@ -10,30 +10,9 @@ import pytest
 import yaml
 
 from raysim.cli import main
-from tests.raysim.test_lidar import ORIGIN, box_file, latlon
+from tests.raysim.helpers import BATCH_SEEDS, tiny_scenario
 
-SEEDS = (11, 12)
-
-
-def tiny_scenario(folder: Path) -> Path:
-    """6 s: a berg at 60 m (LiDAR and radar), an AIS ferry at 300 m, a mesh buoy; small radar sweeps."""
-    folder.mkdir(parents=True, exist_ok=True)
-    box_file(folder, "buoy", (3.0, 3.0, 3.0), (0.0, 0.0, 1.0))
-    (folder / "broken.obj").write_text("this is not a mesh\n", encoding="utf-8")
-    data = {
-        "name": "batch_test", "duration_s": 6.0, "seed": SEEDS[0],
-        "origin": {"lat": ORIGIN[0], "lon": ORIGIN[1]},
-        "environment": {"sea_state": 1, "wind_speed_mps": 3},
-        "own_ship": {"position": latlon(0, 0), "heading_deg": 0},
-        "sensors": {"radar": {"spokes": 512, "samples": 512, "range_m": 926}},
-        "obstacles": [{"name": "berg", "kind": "iceberg", "position": latlon(20, 60), "radius_m": 8, "height_m": 5},
-                      {"name": "buoy", "kind": "mesh", "mesh": "buoy.stl", "position": latlon(-30, 80)}],
-        "ships": [{"name": "ferry", "speed_kn": 8, "length_m": 40, "ais": {"mmsi": 257000009},
-                   "waypoints": [latlon(-200, 300), latlon(400, 300)]}],
-    }
-    path = folder / "tiny.yaml"
-    path.write_text(yaml.safe_dump(data), encoding="utf-8")
-    return path
+SEEDS = BATCH_SEEDS
 
 
 def summary(batch: Path) -> list[dict]:

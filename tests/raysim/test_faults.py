@@ -65,7 +65,7 @@ def test_a_full_disk_in_the_tdm_of_raysim_run_names_the_recording(tmp_path, monk
 
 
 def test_a_full_disk_stops_a_batch_with_one_line(tmp_path):
-    from tests.raysim.test_batch import tiny_scenario
+    from tests.raysim.helpers import tiny_scenario
 
     scenario = tiny_scenario(tmp_path / "scenario")  # 6 s with the LiDAR: far more than 2 MB
     with small_disk(tmp_path / "disk", 2_000_000) as disk:

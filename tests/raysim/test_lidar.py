@@ -9,43 +9,9 @@ import numpy as np
 import pytest
 import trimesh
 
-from raysim.cli import main
-from raysim.geodesy import LocalFrame
 from groundfloor import hdl32e
-
-ORIGIN = (59.43, 10.47)
-FRAME = LocalFrame(*ORIGIN)
-
-
-def latlon(x_m: float, y_m: float) -> list[float]:
-    lat, lon = FRAME.to_geodetic(x_m, y_m)
-    return [float(lat), float(lon)]
-
-
-def box_file(tmp_path, name: str, size_m, centre_m=(0.0, 0.0, 0.0)) -> str:
-    """A box mesh in the body frame, written as STL."""
-    mesh = trimesh.creation.box(extents=size_m)
-    mesh.apply_translation(centre_m)
-    path = tmp_path / f"{name}.stl"
-    mesh.export(path)
-    return path.name
-
-
-def scenario(tmp_path, obstacles=(), ships=(), own=None, lidar=None, duration=0.25, environment=None):
-    data = {
-        "name": "lidar_test",
-        "duration_s": duration,
-        "seed": 3,
-        "origin": {"lat": ORIGIN[0], "lon": ORIGIN[1]},
-        "environment": environment or {"sea_state": 0, "wind_speed_mps": 0},
-        "own_ship": own or {"position": latlon(0, 0), "heading_deg": 0,
-                             "motion": {"roll_amplitude_deg": 0, "pitch_amplitude_deg": 0, "heave_amplitude_m": 0}},
-        "sensors": {"lidar": {"mount": {"x_m": 0.0, "z_m": 3.0}, **(lidar or {})}},
-        "obstacles": list(obstacles),
-        "ships": list(ships),
-    }
-    return data
-
+from raysim.cli import main
+from tests.raysim.helpers import ORIGIN, box_file, latlon, scenario
 
 def render(write_scenario, tmp_path, data, name="rec"):
     import yaml

@@ -12,7 +12,7 @@ from raysim.scenario import load_scenario
 from raysim.sensors.carrier import CarrierScene
 from raysim.sensors.radar import RadarRenderer
 from raysim.world import World
-from tests.raysim.test_lidar import box_file, latlon, scenario
+from tests.raysim.helpers import box_file, latlon, scenario
 
 SPOKES, SAMPLES = 512, 512
 

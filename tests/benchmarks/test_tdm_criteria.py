@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.tdm.conftest import render_recording
+from tests.conftest import render_recording
 
 REPO = Path(__file__).resolve().parents[2]
 

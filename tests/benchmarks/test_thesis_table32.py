@@ -14,7 +14,7 @@ import math
 
 import pytest
 
-from tests.tdm.conftest import REPO, render_recording
+from tests.conftest import REPO, render_recording
 
 #: Scenario seconds rendered: the thesis's 5 minutes (50 s transient, 250 s steady state). With only
 #: 70 s of steady state the comparison is at the mercy of a few AIS reports (fused north std 1.55 m
