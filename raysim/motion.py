@@ -234,10 +234,7 @@ def waypoint_track(
     wp = np.asarray(waypoints_m, dtype=float).reshape(-1, 2)
     n_steps = int(np.ceil((duration_s + 10.0) / dt_s)) + 1
     if speed_mps <= 0 or wp.shape[0] == 1:
-        if heading_rad is None:
-            heading_rad = float(np.arctan2(*(wp[1] - wp[0])[::-1])) if wp.shape[0] > 1 else 0.0
-        ones = np.ones(1)
-        return SampledTrack(dt_s, wp[0, 0] * ones, wp[0, 1] * ones, heading_rad * ones, speed_mps=0 * ones, yaw_rate_rps=0 * ones)
+        return _still_track(wp, heading_rad, dt_s)
     legs = [(wp[i], wp[i + 1]) for i in range(wp.shape[0] - 1)]
     if at_end == "loop":
         legs.append((wp[-1], wp[0]))
@@ -257,22 +254,10 @@ def waypoint_track(
         along_unit = (b - a) / length
         course = h + float(_wrap_pi(np.arctan2(along_unit[1], along_unit[0]) - h))
         is_last = leg_index == len(legs) - 1 and at_end != "loop"
-        if is_last:
-            switch_at = length if at_end == "stop" else np.inf
-        else:
-            na, nb = legs[(leg_index + 1) % len(legs)]
-            next_unit = (nb - na) / np.hypot(*(nb - na))
-            turn = float(_wrap_pi(np.arctan2(next_unit[1], next_unit[0]) - np.arctan2(along_unit[1], along_unit[0])))
-            next_length = float(np.hypot(*(nb - na)))
-            switch_at = length - min(max(wheel_over_distance_m(turn, U, T), 0.0), length, next_length)
+        switch_at = _switch_at_m(legs, leg_index, is_last, at_end, length, along_unit, U, T)
         remaining = n_steps - 1 - steps_done
         window = min(remaining, int(np.ceil(((max(length, 1.0) + U * T) / U + 5 * T) / dt_s)) + 2)
-        j = np.arange(1, window + 1)
-        h0 = h
-        heading = course + (h0 - course) * np.exp(-j * dt_s / T)
-        mid = course + (h0 - course) * np.exp(-(j - 0.5) * dt_s / T)
-        px = p[0] + U * dt_s * np.cumsum(np.cos(mid))
-        py = p[1] + U * dt_s * np.cumsum(np.sin(mid))
+        heading, px, py = _steer(p, h, course, U, T, dt_s, window)
         along = (px - a[0]) * along_unit[0] + (py - a[1]) * along_unit[1]
         reached = np.nonzero(along >= switch_at)[0]
         k = int(reached[0]) + 1 if reached.size else window
@@ -293,6 +278,41 @@ def waypoint_track(
             leg_index += 1
     cat = np.concatenate
     return SampledTrack(dt_s, cat(xs), cat(ys), cat(hs), speed_mps=cat(us), yaw_rate_rps=cat(rs))
+
+
+def _still_track(wp: np.ndarray, heading_rad: float | None, dt_s: float) -> SampledTrack:
+    """A ship lying still at the first waypoint, heading ``heading_rad`` (default: the first leg's course, or 0)."""
+    if heading_rad is None:
+        heading_rad = float(np.arctan2(*(wp[1] - wp[0])[::-1])) if wp.shape[0] > 1 else 0.0
+    ones = np.ones(1)
+    return SampledTrack(dt_s, wp[0, 0] * ones, wp[0, 1] * ones, heading_rad * ones, speed_mps=0 * ones, yaw_rate_rps=0 * ones)
+
+
+def _switch_at_m(legs: list, leg_index: int, is_last: bool, at_end: str, length: float, along_unit: np.ndarray,
+                 speed_mps: float, time_constant_s: float) -> float:
+    """Distance along the active leg at which the ship turns onto the next: the wheel-over point.
+
+    On the last leg: its end for ``stop``, never for ``continue``.
+    """
+    if is_last:
+        return length if at_end == "stop" else np.inf
+    na, nb = legs[(leg_index + 1) % len(legs)]
+    next_unit = (nb - na) / np.hypot(*(nb - na))
+    turn = float(_wrap_pi(np.arctan2(next_unit[1], next_unit[0]) - np.arctan2(along_unit[1], along_unit[0])))
+    next_length = float(np.hypot(*(nb - na)))
+    return length - min(max(wheel_over_distance_m(turn, speed_mps, time_constant_s), 0.0), length, next_length)
+
+
+def _steer(p: np.ndarray, h0: float, course: float, speed_mps: float, time_constant_s: float, dt_s: float,
+           window: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``window`` steps from position ``p`` and heading ``h0`` towards ``course``: headings (exact) and
+    positions (x, y; each step at its mid-step heading)."""
+    j = np.arange(1, window + 1)
+    heading = course + (h0 - course) * np.exp(-j * dt_s / time_constant_s)
+    mid = course + (h0 - course) * np.exp(-(j - 0.5) * dt_s / time_constant_s)
+    px = p[0] + speed_mps * dt_s * np.cumsum(np.cos(mid))
+    py = p[1] + speed_mps * dt_s * np.cumsum(np.sin(mid))
+    return heading, px, py
 
 
 # --------------------------------------------------------------------------- waves and bodies
