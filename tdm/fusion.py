@@ -43,6 +43,25 @@ from tdm.tracker import Track
 
 #: Classes of targets that do not move: an ended one is looked for where it was for ``revive_still_s``.
 STILL_DESCRIPTORS = frozenset({"iceberg", "fixed obstacle"})
+#: Degrees of freedom of the track-to-track gate: east and north position.
+POSITION_DOF = 2
+#: A track lies inside a target's footprint within its half length plus this many standard deviations
+#: of the track's position (the radar beam smears a ship's ends by tens of metres at range).
+FOOTPRINT_SIGMAS = 3.0
+#: Two targets without AIS are one object only if their velocities differ by less than this, m/s.
+MERGE_SPEED_MPS = 2.0
+#: A target is a vessel once it has moved (faster than ``vessel_speed_mps`` by VESSEL_SIGMAS standard
+#: deviations of its speed) for this long, s.
+VESSEL_MOVING_S = 5.0
+VESSEL_SIGMAS = 2
+#: A target is still while its speed is under this fraction of ``vessel_speed_mps``.
+STILL_SPEED_FRACTION = 0.5
+#: A member leaves its target when its statistic exceeds this many gates, or its distance this many
+#: ``max_distance_m``: looser than joining, so that a track does not flicker in and out.
+RELEASE_GATES = 4
+RELEASE_DISTANCES = 2
+#: The order in which the free tracks of each sensor look for a target: AIS (the identity) first.
+SENSOR_ORDER = ("ais", "lidar", "radar")
 
 
 @dataclass(frozen=True)
@@ -130,7 +149,7 @@ class Fuser:
         self.lengths_by_mmsi: dict[int, float] = {}
         self._ended: list[FusedTarget] = []
         self._ids = itertools.count(1)
-        self._gate = chi2_gate(config.gate_probability, 2)
+        self._gate = chi2_gate(config.gate_probability, POSITION_DOF)
         self._moving_since: dict[int, float] = {}
         self._still_since: dict[int, float] = {}
 
@@ -159,8 +178,8 @@ class Fuser:
                                and self._inside(states[k], x, half)}
             claimed.update(target.absorbed)
         # new or released tracks: join a target without a track of their sensor, else start one
-        order = ["ais", "lidar", "radar"]
-        for sensor in sorted(tracks_by_sensor, key=lambda s: order.index(s) if s in order else 9):
+        for sensor in sorted(tracks_by_sensor,
+                             key=lambda s: SENSOR_ORDER.index(s) if s in SENSOR_ORDER else len(SENSOR_ORDER)):
             free = [tr for tr in tracks_by_sensor[sensor] if (sensor, tr.track_id) not in claimed]
             if not free:
                 continue
@@ -219,7 +238,7 @@ class Fuser:
     def _inside(state, centre: np.ndarray, half_length_m: float) -> bool:
         x, p = state
         sigma = np.sqrt(max(np.linalg.eigvalsh(p[:2, :2])[-1], 0.0))
-        return bool(np.hypot(*(x[:2] - centre[:2])) <= half_length_m + 3.0 * sigma)
+        return bool(np.hypot(*(x[:2] - centre[:2])) <= half_length_m + FOOTPRINT_SIGMAS * sigma)
 
     def _revive(self, state, t_s: float) -> FusedTarget | None:
         """The recently ended target whose footprint (its last state predicted to ``t_s``) holds ``state``."""
@@ -264,7 +283,7 @@ class Fuser:
                 n_ais = ("ais" in older.members) + ("ais" in younger.members)
                 if n_ais == 2:
                     continue
-                if n_ais == 0 and np.hypot(*(ekf.velocity_en(xo) - ekf.velocity_en(xy))) > 2.0:
+                if n_ais == 0 and np.hypot(*(ekf.velocity_en(xo) - ekf.velocity_en(xy))) > MERGE_SPEED_MPS:
                     continue
                 for sensor, track_id in younger.members.items():
                     if sensor in older.members:
@@ -298,7 +317,7 @@ class Fuser:
             for key in [k for k in target.members.items() if k[0] != "ais"]:
                 xi, pi_ = states[key]
                 d = xi[:2] - xa[:2]
-                if mahalanobis2(d, pi_[:2, :2] + pa[:2, :2]) > 4 * self._gate or np.hypot(*d) > 2 * self.config.max_distance_m:
+                if self._released(d, pi_[:2, :2] + pa[:2, :2]):
                     del target.members[key[0]]
             return
         keys = list(target.members.items())
@@ -311,8 +330,12 @@ class Fuser:
             x, p = fuse(xs, ps, self.config.rule)
             xi, pi_ = states[key]
             d = xi[:2] - x[:2]
-            if mahalanobis2(d, pi_[:2, :2] + p[:2, :2]) > 4 * self._gate or np.hypot(*d) > 2 * self.config.max_distance_m:
+            if self._released(d, pi_[:2, :2] + p[:2, :2]):
                 del target.members[key[0]]
+
+    def _released(self, d: np.ndarray, s: np.ndarray) -> bool:
+        """A member at position difference ``d`` (m, 2) with summed covariance ``s`` (m^2) leaves its target."""
+        return mahalanobis2(d, s) > RELEASE_GATES * self._gate or np.hypot(*d) > RELEASE_DISTANCES * self.config.max_distance_m
 
     def _classify(self, target: FusedTarget, x: np.ndarray, p: np.ndarray, t_s: float, height_m: float) -> None:
         cfg = self.config
@@ -321,15 +344,15 @@ class Fuser:
             return
         speed, sigma = x[ekf.U], np.sqrt(max(p[ekf.U, ekf.U], 0.0))
         tid = target.target_id
-        if speed - 2 * sigma > cfg.vessel_speed_mps:
+        if speed - VESSEL_SIGMAS * sigma > cfg.vessel_speed_mps:
             self._moving_since.setdefault(tid, t_s)
-            if t_s - self._moving_since[tid] >= 5.0:
+            if t_s - self._moving_since[tid] >= VESSEL_MOVING_S:
                 target.descriptor = "vessel"
         else:
             self._moving_since.pop(tid, None)
         if target.descriptor == "vessel":
             return
-        if abs(speed) < 0.5 * cfg.vessel_speed_mps and sigma < cfg.vessel_speed_mps:
+        if abs(speed) < STILL_SPEED_FRACTION * cfg.vessel_speed_mps and sigma < cfg.vessel_speed_mps:
             self._still_since.setdefault(tid, t_s)
             if t_s - self._still_since[tid] >= cfg.settle_s:
                 big = x[ekf.ALPHA] >= cfg.iceberg_area_m2 or (np.isfinite(height_m) and height_m >= cfg.iceberg_height_m)

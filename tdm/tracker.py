@@ -30,6 +30,31 @@ from tdm.detections import AisReport, AisStatic, Detections
 
 #: What a strong detection counts towards confirmation (:class:`TrackerConfig` ``strong_from_db``), hits.
 STRONG_HIT = 1.5
+#: Degrees of freedom of the association gate: east and north position.
+POSITION_DOF = 2
+#: A track's second detection sets its course and speed (two-point initialisation) only when it comes
+#: at least this long after the first, s (two plots of one sweep do not give a velocity).
+MIN_TWO_POINT_DT_S = 1e-3
+#: The course is set only when the two-point speed exceeds this many of its standard deviations.
+COURSE_SIGMAS = 2.0
+#: Too slow to tell the course: the speed variance is bounded by the two-point variance plus this,
+#: (m/s)^2 ((0.5 m/s)^2).
+SLOW_SPEED_VAR_MARGIN_MPS2 = 0.25
+#: Turn-rate standard deviation of a new track, deg/s (a ship turns at most a few deg/s).
+INIT_TURN_RATE_SIGMA_DEG_S = 3.0
+#: Position variance of a new track before its detection's covariance replaces it, m^2.
+_INIT_POSITION_VAR_M2 = 1.0
+#: Smoothing of a track's length and height over its detections: the weight kept by the old value
+#: and the weight of the new detection (exponential moving averages).
+LENGTH_KEEP, LENGTH_GAIN = 0.8, 0.2
+HEIGHT_KEEP, HEIGHT_GAIN = 0.9, 0.1
+#: Updates after which a track's length is smoothed rather than the largest seen (its first two
+#: detections may catch the object from one end).
+LENGTH_MAX_UPDATES = 2
+SECONDS_PER_MINUTE = 60.0
+#: An AIS course over ground is used only above this speed over ground, m/s (0.6 kn: below it the COG
+#: of a drifting ship is noise).
+AIS_COG_MIN_SOG_MPS = 0.3
 
 
 @dataclass(frozen=True)
@@ -149,7 +174,7 @@ class PositionTracker:
         self.config = config
         self.tracks: list[Track] = []
         self._ids = itertools.count(1)
-        self._gate = chi2_gate(config.gate_probability, 2)
+        self._gate = chi2_gate(config.gate_probability, POSITION_DOF)
 
     # ---- public -------------------------------------------------------------------------
     def process(self, dets: Detections, ownship_position_m: np.ndarray) -> None:
@@ -214,18 +239,18 @@ class PositionTracker:
 
     def _update(self, track: Track, dets: Detections, j: int, cov_j: np.ndarray) -> None:
         t = float(dets.time_s[j])
-        if track.n_updates == 1 and t - track.t_s > 1e-3:
+        if track.n_updates == 1 and t - track.t_s > MIN_TWO_POINT_DT_S:
             self._two_point(track, dets.position_m[j], cov_j, t)
         x, p = track.predicted(t)
         z, r = self._measurement(dets, j, cov_j)
         track.x, track.p, _ = ekf.update(x, p, z, ekf.H_POSITION_SIZE, r)
         track.t_s = track.updated_s = t
         track.n_updates += 1
-        track.length_m = 0.8 * track.length_m + 0.2 * float(dets.length_m[j]) if track.n_updates > 2 else \
-            max(track.length_m, float(dets.length_m[j]))
+        track.length_m = LENGTH_KEEP * track.length_m + LENGTH_GAIN * float(dets.length_m[j]) \
+            if track.n_updates > LENGTH_MAX_UPDATES else max(track.length_m, float(dets.length_m[j]))
         if np.isfinite(dets.height_m[j]):
             track.height_m = float(dets.height_m[j]) if not np.isfinite(track.height_m) else \
-                0.9 * track.height_m + 0.1 * float(dets.height_m[j])
+                HEIGHT_KEEP * track.height_m + HEIGHT_GAIN * float(dets.height_m[j])
         self._record(track, self._hit_weight(dets, j))
 
     def _hit_weight(self, dets: Detections, j: int) -> float:
@@ -250,7 +275,7 @@ class PositionTracker:
         speed = float(np.hypot(*v))
         sigma_speed = float(np.sqrt(np.trace(cov_v) / 2.0))
         x, p = track.x.copy(), track.p.copy()
-        if speed > 2.0 * sigma_speed:
+        if speed > COURSE_SIGMAS * sigma_speed:
             ve, vn = v
             jac = np.array([[vn / speed**2, -ve / speed**2], [ve / speed, vn / speed]])
             polar = jac @ cov_v @ jac.T
@@ -258,14 +283,14 @@ class PositionTracker:
             p[np.ix_([ekf.PSI, ekf.U], [ekf.PSI, ekf.U])] = polar
         else:
             # too slow to tell the course yet: keep it unknown, bound the speed
-            p[ekf.U, ekf.U] = min(p[ekf.U, ekf.U], sigma_speed**2 + 0.25)
+            p[ekf.U, ekf.U] = min(p[ekf.U, ekf.U], sigma_speed**2 + SLOW_SPEED_VAR_MARGIN_MPS2)
         track.x, track.p = x, p
 
     def _initiate(self, dets: Detections, j: int, cov_j: np.ndarray) -> None:
         cfg = self.config
         x = np.array([dets.position_m[j, 0], dets.position_m[j, 1], 0.0, 0.0, 0.0, dets.cross_section_m2[j]])
-        p = np.diag([1.0, 1.0, np.pi**2, cfg.init_speed_sigma_mps**2, np.radians(3.0)**2,
-                     cfg.cross_section_sigma_m2**2])
+        p = np.diag([_INIT_POSITION_VAR_M2, _INIT_POSITION_VAR_M2, np.pi**2, cfg.init_speed_sigma_mps**2,
+                     np.radians(INIT_TURN_RATE_SIGMA_DEG_S)**2, cfg.cross_section_sigma_m2**2])
         p[:2, :2] = cov_j
         t = float(dets.time_s[j])
         track = Track(next(self._ids), self.sensor, x, p, t, t, t,
@@ -320,7 +345,7 @@ class AisTrackerConfig:
 #: Prior variances of an AIS track's states that its first report does not measure: position
 #: (always measured), course pi^2 (unknown), speed (5 m/s)^2, turn rate (3 deg/s)^2, cross-section
 #: (1000 m^2)^2.
-AIS_PRIOR_VAR = (1e6, 1e6, np.pi**2, 25.0, np.radians(3.0) ** 2, 1e6)
+AIS_PRIOR_VAR = (1e6, 1e6, np.pi**2, 25.0, np.radians(INIT_TURN_RATE_SIGMA_DEG_S) ** 2, 1e6)
 
 
 class AisTracker:
@@ -340,7 +365,7 @@ class AisTracker:
         cfg = self.config
         rows, z, var = [ekf.E, ekf.N], [report.position_m[0], report.position_m[1]], [cfg.position_var_m2] * 2
         angle_rows: tuple[int, ...] = ()
-        moving = np.isfinite(report.sog_mps) and report.sog_mps > 0.3
+        moving = np.isfinite(report.sog_mps) and report.sog_mps > AIS_COG_MIN_SOG_MPS
         if np.isfinite(report.cog_deg) and moving:
             angle_rows = (len(rows),)
             rows.append(ekf.PSI)
@@ -352,8 +377,8 @@ class AisTracker:
             var.append(cfg.sog_var_kn2 * KNOT_MPS**2)
         if np.isfinite(report.rot_deg_per_min):
             rows.append(ekf.R)
-            z.append(np.radians(report.rot_deg_per_min) / 60.0)
-            var.append(cfg.rot_var_deg2_per_min2 * (np.radians(1.0) / 60.0) ** 2)
+            z.append(np.radians(report.rot_deg_per_min) / SECONDS_PER_MINUTE)
+            var.append(cfg.rot_var_deg2_per_min2 * (np.radians(1.0) / SECONDS_PER_MINUTE) ** 2)
         t = float(report.time_s)
         track = self.tracks.get(report.mmsi)
         if track is None or t - track.updated_s > cfg.coast_s:

@@ -124,6 +124,155 @@ def _not_available(value, code: float) -> float:
     return float("nan") if value is None or float(value) >= code else float(value)
 
 
+#: Messages whose dimensions and type are read (types 5 and 19 carry them with the name).
+_NAME_AND_SHIP_TYPES = (5, 19)
+#: Types whose ROT indicator is read (Class A position reports).
+_CLASS_A_POSITION_TYPES = (1, 2, 3)
+#: Payload bits of a type 24 message of an unknown part (the longer, part B).
+_MIN_BITS_24_OTHER = 168
+#: Highest valid true heading, deg (511: not available).
+_HEADING_LIMIT_DEG = 360
+
+
+class _AisDecoder:
+    """Decodes the sentences of one NMEA log into report rows and static data, counting what it skips."""
+
+    def __init__(self, start_time_unix_s: float, stats: ReadStats):
+        self.start_time_unix_s = float(start_time_unix_s)
+        self.stats = stats
+        self.rows: list[tuple[float, int, int, float, float, float, float, float, float]] = []
+        self.static: dict[int, AisStatic] = {}
+        self.pending: dict[tuple, list] = {}  # (fragment count, sequence id, channel) -> [(sentence, time), ...]
+
+    def skip(self, what: str, n: int = 1) -> None:
+        self.stats.count(PREFIX + what, n)
+
+    def line(self, line: bytes) -> None:
+        """One line of the log: a sentence, a fragment of a multi-sentence message, or a line skipped."""
+        line = line.strip()
+        if not line:
+            return
+        sentence = self._sentence(line)
+        if sentence is None:
+            return
+        t_unix = _tag_time_s(sentence)
+        if t_unix is None:
+            self.skip("line without a (valid) TAG block time skipped")
+            return
+        if sentence.type == "VDO":
+            return
+        if sentence.frag_cnt == 1:
+            self.message(sentence, t_unix)
+        else:
+            self._fragment(sentence, t_unix)
+
+    def _sentence(self, line: bytes):
+        """The line's !AIVDM sentence with a good checksum, or None (counted)."""
+        try:
+            sentence = NMEASentenceFactory.produce(line)
+        except UnknownMessageException:
+            other = _OTHER_SENTENCE.match(line.rsplit(b"\\", 1)[-1])
+            self.skip("sentence other than !AIVDM skipped" if other else "unparsable line skipped")
+            return None
+        except (AISBaseException, ValueError, IndexError, TypeError, UnicodeError):
+            self.skip("unparsable line skipped")
+            return None
+        if getattr(sentence, "TYPE", None) != NMEAMessage.TYPE:
+            self.skip("sentence other than !AIVDM skipped")
+            return None
+        if not sentence.is_valid:
+            self.skip("bad checksum skipped")
+            return None
+        return sentence
+
+    def _fragment(self, sentence, t_unix: float) -> None:
+        """A fragment: kept until its message is whole (then decoded at its first fragment's time)."""
+        key = (sentence.frag_cnt, sentence.seq_id, sentence.channel)
+        group = self.pending.get(key)
+        if sentence.frag_num == 1:
+            if group:
+                self.skip("orphan fragment skipped", len(group))
+            self.pending[key] = [(sentence, t_unix)]
+            return
+        if not group or group[-1][0].frag_num != sentence.frag_num - 1:
+            self.skip("orphan fragment skipped", 1 + len(group or []))
+            self.pending.pop(key, None)
+            return
+        group.append((sentence, t_unix))
+        if len(group) == sentence.frag_cnt:
+            del self.pending[key]
+            self.message(NMEAMessage.assemble_from_iterable([s for s, _ in group]), group[0][1])
+
+    def finish(self) -> None:
+        """Count the fragments of messages never completed."""
+        for group in self.pending.values():
+            self.skip("orphan fragment skipped", len(group))
+
+    def message(self, sentence, time_unix_s: float) -> None:
+        """A whole message: static data and/or a position report row, or skipped (counted)."""
+        try:
+            msg = sentence.decode()
+        except AISBaseException:
+            self.skip(f"message type {sentence.ais_id} skipped (not used)")
+            return
+        except (ValueError, IndexError, TypeError, KeyError):
+            self.skip("undecodable message skipped")
+            return
+        kind = int(msg.msg_type)
+        bits = _payload_bits(sentence)
+        if kind == 24:
+            need = MIN_BITS_24.get(int(msg.partno or 0), _MIN_BITS_24_OTHER)
+        elif kind in MIN_BITS:
+            need = MIN_BITS[kind]
+        else:
+            self.skip(f"message type {kind} skipped (not used)")
+            return
+        if bits < need:
+            self.skip("message too short for its type skipped")
+            return
+        if kind in STATIC_TYPES:
+            self._static(msg, kind)
+        if kind in POSITION_TYPES:
+            self._position(sentence, msg, kind, time_unix_s)
+
+    def _static(self, msg, kind: int) -> None:
+        entry = self.static.setdefault(int(msg.mmsi), AisStatic(int(msg.mmsi)))
+        if kind in _NAME_AND_SHIP_TYPES or (kind == 24 and msg.partno == 0):
+            entry.name = _text(msg.shipname)
+        if kind in _NAME_AND_SHIP_TYPES or (kind == 24 and msg.partno == 1):
+            entry.ship_type = int(msg.ship_type or 0)
+            if hasattr(msg, "to_bow"):  # a type 24 B of an auxiliary craft has a mothership instead
+                entry.length_m = _dimension(msg.to_bow, msg.to_stern)
+                entry.beam_m = _dimension(msg.to_port, msg.to_starboard)
+
+    def _position(self, sentence, msg, kind: int, time_unix_s: float) -> None:
+        lon, lat = msg.lon, msg.lat
+        if lon is None or lat is None or abs(lon) >= LON_NOT_AVAILABLE or abs(lat) >= LAT_NOT_AVAILABLE \
+                or abs(lat) > 90.0 or abs(lon) > 180.0:
+            self.skip("position report without a position (lon 181 / lat 91) skipped")
+            return
+        sog = _not_available(msg.speed, SOG_NOT_AVAILABLE_KN) * MPS_PER_KNOT
+        cog = _not_available(msg.course, COG_NOT_AVAILABLE_DEG)
+        heading = float("nan") if msg.heading is None or msg.heading >= _HEADING_LIMIT_DEG else float(msg.heading)
+        rot = float("nan")
+        if kind in _CLASS_A_POSITION_TYPES:
+            rot = rot_deg_per_min(bit_vector(sentence.payload, sentence.fill_bits).get_num(ROT_BIT, ROT_WIDTH, True))
+        self.rows.append((time_unix_s - self.start_time_unix_s, int(msg.mmsi), kind, float(lat), float(lon), cog, sog,
+                          heading, rot))
+
+    def reports(self, frame: EnuFrame) -> list[AisReport]:
+        """The position reports, sorted by time (stable: file order within a second), in ENU."""
+        if not self.rows:
+            return []
+        rows = sorted(self.rows, key=lambda r: r[0])
+        lat = np.array([r[3] for r in rows])
+        lon = np.array([r[4] for r in rows])
+        east, north = frame.to_enu(lat, lon)
+        return [AisReport(time_s=r[0], mmsi=r[1], position_m=np.array([e, n]), cog_deg=r[5], sog_mps=r[6],
+                          heading_deg=r[7], rot_deg_per_min=r[8], msg_type=r[2])
+                for r, e, n in zip(rows, east, north)]
+
+
 def read_ais(path: Path, frame: EnuFrame, start_time_unix_s: float,
              stats: ReadStats) -> tuple[list[AisReport], dict[int, AisStatic]]:
     """Position reports and static data of an AIS NMEA log.
@@ -160,110 +309,8 @@ def read_ais(path: Path, frame: EnuFrame, start_time_unix_s: float,
     except FileNotFoundError:
         return [], {}
 
-    rows: list[tuple[float, int, int, float, float, float, float, float, float]] = []
-    static: dict[int, AisStatic] = {}
-    pending: dict[tuple, list] = {}  # (fragment count, sequence id, channel) -> [(sentence, time), ...]
-
-    def handle(sentence, time_unix_s: float) -> None:
-        try:
-            msg = sentence.decode()
-        except AISBaseException:
-            stats.count(PREFIX + f"message type {sentence.ais_id} skipped (not used)")
-            return
-        except (ValueError, IndexError, TypeError, KeyError):
-            stats.count(PREFIX + "undecodable message skipped")
-            return
-        kind = int(msg.msg_type)
-        bits = _payload_bits(sentence)
-        if kind == 24:
-            need = MIN_BITS_24.get(int(msg.partno or 0), 168)
-        elif kind in MIN_BITS:
-            need = MIN_BITS[kind]
-        else:
-            stats.count(PREFIX + f"message type {kind} skipped (not used)")
-            return
-        if bits < need:
-            stats.count(PREFIX + "message too short for its type skipped")
-            return
-        mmsi = int(msg.mmsi)
-        if kind in STATIC_TYPES:
-            entry = static.setdefault(mmsi, AisStatic(mmsi))
-            if kind in (5, 19) or (kind == 24 and msg.partno == 0):
-                entry.name = _text(msg.shipname)
-            if kind in (5, 19) or (kind == 24 and msg.partno == 1):
-                entry.ship_type = int(msg.ship_type or 0)
-                if hasattr(msg, "to_bow"):  # a type 24 B of an auxiliary craft has a mothership instead
-                    entry.length_m = _dimension(msg.to_bow, msg.to_stern)
-                    entry.beam_m = _dimension(msg.to_port, msg.to_starboard)
-        if kind not in POSITION_TYPES:
-            return
-        lon, lat = msg.lon, msg.lat
-        if lon is None or lat is None or abs(lon) >= LON_NOT_AVAILABLE or abs(lat) >= LAT_NOT_AVAILABLE \
-                or abs(lat) > 90.0 or abs(lon) > 180.0:
-            stats.count(PREFIX + "position report without a position (lon 181 / lat 91) skipped")
-            return
-        sog = _not_available(msg.speed, SOG_NOT_AVAILABLE_KN) * MPS_PER_KNOT
-        cog = _not_available(msg.course, COG_NOT_AVAILABLE_DEG)
-        heading = float("nan") if msg.heading is None or msg.heading >= 360 else float(msg.heading)
-        rot = float("nan")
-        if kind in (1, 2, 3):
-            rot = rot_deg_per_min(bit_vector(sentence.payload, sentence.fill_bits).get_num(ROT_BIT, ROT_WIDTH, True))
-        rows.append((time_unix_s - float(start_time_unix_s), mmsi, kind, float(lat), float(lon), cog, sog, heading,
-                     rot))
-
+    decoder = _AisDecoder(start_time_unix_s, stats)
     for line in raw.splitlines():
-        line = line.strip()
-        if not line:
-            continue
-        try:
-            sentence = NMEASentenceFactory.produce(line)
-        except UnknownMessageException:
-            other = _OTHER_SENTENCE.match(line.rsplit(b"\\", 1)[-1])
-            stats.count(PREFIX + ("sentence other than !AIVDM skipped" if other else "unparsable line skipped"))
-            continue
-        except (AISBaseException, ValueError, IndexError, TypeError, UnicodeError):
-            stats.count(PREFIX + "unparsable line skipped")
-            continue
-        if getattr(sentence, "TYPE", None) != NMEAMessage.TYPE:
-            stats.count(PREFIX + "sentence other than !AIVDM skipped")
-            continue
-        if not sentence.is_valid:
-            stats.count(PREFIX + "bad checksum skipped")
-            continue
-        t_unix = _tag_time_s(sentence)
-        if t_unix is None:
-            stats.count(PREFIX + "line without a (valid) TAG block time skipped")
-            continue
-        if sentence.type == "VDO":
-            continue
-        if sentence.frag_cnt == 1:
-            handle(sentence, t_unix)
-            continue
-        key = (sentence.frag_cnt, sentence.seq_id, sentence.channel)
-        group = pending.get(key)
-        if sentence.frag_num == 1:
-            if group:
-                stats.count(PREFIX + "orphan fragment skipped", len(group))
-            pending[key] = [(sentence, t_unix)]
-            continue
-        if not group or group[-1][0].frag_num != sentence.frag_num - 1:
-            stats.count(PREFIX + "orphan fragment skipped", 1 + len(group or []))
-            pending.pop(key, None)
-            continue
-        group.append((sentence, t_unix))
-        if len(group) == sentence.frag_cnt:
-            del pending[key]
-            handle(NMEAMessage.assemble_from_iterable([s for s, _ in group]), group[0][1])
-    for group in pending.values():
-        stats.count(PREFIX + "orphan fragment skipped", len(group))
-
-    if not rows:
-        return [], static
-    rows.sort(key=lambda r: r[0])
-    lat = np.array([r[3] for r in rows])
-    lon = np.array([r[4] for r in rows])
-    east, north = frame.to_enu(lat, lon)
-    reports = [AisReport(time_s=r[0], mmsi=r[1], position_m=np.array([e, n]), cog_deg=r[5], sog_mps=r[6],
-                         heading_deg=r[7], rot_deg_per_min=r[8], msg_type=r[2])
-               for r, e, n in zip(rows, east, north)]
-    return reports, static
+        decoder.line(line)
+    decoder.finish()
+    return decoder.reports(frame), decoder.static
