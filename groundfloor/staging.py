@@ -85,14 +85,20 @@ EXIT_INTERRUPTED = 128 + signal.SIGINT  # 130, Ctrl-C
 EXIT_TERMINATED = 128 + signal.SIGTERM  # 143
 
 
-def report_fault(exc: BaseException, out=None, nothing_written: str = "nothing was written") -> int | None:
-    """A command's one line on stderr for an output fault or an interrupt, and its exit code.
+def report_fault(exc: BaseException, out=None, nothing_written: str = "nothing was written",
+                 bad_input: type | tuple = ()) -> int | None:
+    """A command's one line on stderr for bad input, an output fault or an interrupt, and its exit code.
+
+    Bad input (an instance of ``bad_input``, the wing's one-line error): ``error: <exc>``, exit code 2.
 
     A write fault (:func:`is_write_fault`): ``error: <directory>: writing: <what>``, exit code 2 (the
     directory: the :class:`OutputWriteError`'s, else ``out``, else the file's name); Ctrl-C or
     SIGTERM: ``error: interrupted; <nothing_written>`` (or ``terminated``), 130 or 143. Any other
     exception: None, printed nothing (the caller re-raises it).
     """
+    if bad_input and isinstance(exc, bad_input):
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
     if isinstance(exc, KeyboardInterrupt):
         how = "terminated" if isinstance(exc, Terminated) else "interrupted"
         print(f"error: {how}; {nothing_written}", file=sys.stderr)

@@ -349,12 +349,9 @@ def main(argv: list[str] | None = None) -> int:
                 if sigterm.received:  # SIGTERM surfaced as another exception (from a C extension)
                     raise Terminated() from exc
                 raise
-    except InputError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-    except (OSError, KeyboardInterrupt) as exc:  # a write fault or an interrupt: one line (groundfloor.staging)
-        code = report_fault(exc, getattr(args, "out", None))
-        if code is None:
+    except (InputError, OSError, KeyboardInterrupt) as exc:  # bad input, a write fault, an interrupt: one line
+        code = report_fault(exc, getattr(args, "out", None), bad_input=InputError)
+        if code is None:  # an OSError that is no write fault: a bug, with its traceback
             raise
         return code
 

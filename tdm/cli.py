@@ -126,14 +126,11 @@ def _main(argv: list[str] | None) -> int:
             for what, n in sorted((metrics.get("warnings") or {}).items()):
                 print(f"warning: {what}: {n}", file=sys.stderr)
         return 0
-    except RecordingError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-    except (OSError, KeyboardInterrupt) as exc:  # a write fault or an interrupt: one line (groundfloor.staging)
-        code = report_fault(exc, getattr(args, "out", None))
-        if code is None:
-            raise
-        return code
+    except (RecordingError, OSError, KeyboardInterrupt) as exc:  # one line on stderr (groundfloor.staging)
+        code = report_fault(exc, getattr(args, "out", None), bad_input=RecordingError)
+        if code is not None:
+            return code
+        raise  # an OSError that is no write fault: a bug, with its traceback
 
 
 if __name__ == "__main__":  # pragma: no cover
