@@ -14,7 +14,7 @@ For every ship with an enabled transponder (docs/reference.md section 4):
    position error is drawn per axis (east and north) with the configured variance, SOG in knots,
    COG and heading in degrees, ROT in deg/min. A configured ``position_offset_m`` is added to
    every reported position (spoofing, a misplaced antenna). Fields are clamped before encoding
-   (:mod:`raysim.sensors.ais_fields`).
+   (:mod:`raysim.ais_fields`).
 4. Failures and reception: nothing while the transponder is off (``off_periods_s``, or disabled:
    a silent ship), each transmission lost with ``dropout_probability``, and only what is within
    ``sensors.ais.range_m`` and the VHF radio horizon ``4.12 (sqrt(h_tx) + sqrt(h_rx))`` km
@@ -39,20 +39,38 @@ from pathlib import Path
 import numpy as np
 from pyais import encode_dict
 
+from groundfloor.units import KNOTS_PER_MPS
 from raysim.pose import heading_deg_from_yaw
 from raysim.random_streams import stream
 from raysim.recording.jsonl import course_and_speed
 from raysim.recording.nmea import tag_block
 from raysim.recording.staging import atomic_path
-from raysim.sensors import ais_fields as fields
+from raysim.scenario import AisNoise, Ship, ShipAis
+from raysim import ais_fields as fields
 from raysim.sensors import ais_schedule as schedule
 from raysim.sensors.gauss_markov import white_plus_bias
+from raysim.sensors.context import SensorContext
+from raysim.world import World, WorldObject
 
 __all__ = ["AisMessage", "ship_messages", "received_messages", "ais_sentences", "ais_lines", "write_ais_files",
            "render_ais", "radio_horizon_m"]
 
-KNOTS_PER_MPS = 3600.0 / 1852.0
 GRID_S = 0.5  # kinematics grid (finer than the 2 s shortest interval)
+
+#: Ship type reported when a Class A transponder gives none: 70, cargo (ITU-R M.1371 table 53).
+DEFAULT_SHIP_TYPE_CLASS_A = 70
+#: Ship type reported when a Class B transponder gives none: 37, pleasure craft (ITU-R M.1371 table 53).
+DEFAULT_SHIP_TYPE_CLASS_B = 37
+#: Default draught per metre of length (unverified rule of thumb), and the largest draught a
+#: type 5 message holds, m (ITU-R M.1371: 0.1 m steps, 25.5 m = 25.5 m or more).
+DRAUGHT_PER_LENGTH = 0.06
+MAX_DRAUGHT_M = 25.5
+#: Position accuracy flag: 1 (high) when the position error is at most this, m (ITU-R M.1371, < 10 m DGNSS).
+HIGH_ACCURACY_M = 10.0
+#: The first static message (type 5 or 24) goes out within this many seconds of the start, s.
+FIRST_STATIC_WITHIN_S = 6.0
+#: Reporting intervals further apart than this, s, are a change of rate (type 3 instead of 1).
+RATE_CHANGE_TOLERANCE_S = 1e-6
 
 
 def radio_horizon_m(tx_height_m: float, rx_height_m: float) -> float:
@@ -70,7 +88,7 @@ class AisMessage:
     data: dict
 
 
-def _kinematics(obj, t: np.ndarray) -> dict:
+def _kinematics(obj: WorldObject, t: np.ndarray) -> dict:
     poses = obj.motion.poses(t)
     cog, sog_mps = course_and_speed(obj.motion.velocity_mps(t), poses.yaw_rad)
     heading = heading_deg_from_yaw(poses.yaw_rad)
@@ -79,7 +97,7 @@ def _kinematics(obj, t: np.ndarray) -> dict:
             "heading_deg": heading, "rot_deg_per_min": rot}
 
 
-def ship_messages(world, obj, ship_cfg) -> list[AisMessage]:
+def ship_messages(world: World, obj: WorldObject, ship_cfg: Ship) -> list[AisMessage]:
     """Every message the transponder of ``obj`` transmits during the run (before reception).
 
     Parameters
@@ -92,27 +110,50 @@ def ship_messages(world, obj, ship_cfg) -> list[AisMessage]:
     """
     s = world.scenario
     cfg = obj.ais
-    noise = s.sensors.ais.noise
-    mmsi = cfg.mmsi
-    duration = s.duration_s
-    grid = np.arange(0.0, duration + GRID_S, GRID_S)
+    grid = np.arange(0.0, s.duration_s + GRID_S, GRID_S)
     kin = _kinematics(obj, grid)
-    status_name = cfg.nav_status
-    if status_name == "auto":
-        status_name = "at_anchor" if ship_cfg.speed_kn == 0 else "under_way"
-    status = fields.NAV_STATUS[status_name]
-    anchored = np.full(grid.size, status_name in ("at_anchor", "moored"))
-    turning = np.abs(kin["rot_deg_per_min"]) > schedule.TURNING_DEG_PER_MIN
-    rng = stream(s.seed, f"ais.{mmsi}.schedule")
-    if cfg.ais_class == "A":
-        interval = schedule.class_a_interval_s(kin["sog_kn"], turning, anchored)
-    else:
-        interval = schedule.class_b_interval_s(kin["sog_kn"])
-    t = schedule.due_times(grid, interval, rng, duration)
+    status_name = _nav_status_name(cfg, ship_cfg)
+    rng = stream(s.seed, f"ais.{cfg.mmsi}.schedule")
+    interval = _interval_s(cfg, kin, status_name)
+    t = schedule.due_times(grid, interval, rng, s.duration_s)
+    reported = _reported_values(world, cfg, grid, kin, t)
+    messages = _position_reports(s.start_time, cfg, fields.NAV_STATUS[status_name], t, np.interp(t, grid, interval),
+                                 reported, _high_accuracy(s.sensors.ais.noise))
+    messages += _static_reports(cfg, obj, rng, s.duration_s)
+    messages.sort(key=lambda m: (m[0], m[1]["msg_type"]))
+    first = "A" if rng.uniform() < 0.5 else "B"
+    other = {"A": "B", "B": "A"}
+    return [AisMessage(tm, cfg.mmsi, first if i % 2 == 0 else other[first], data)
+            for i, (tm, data) in enumerate(messages)]
 
-    # errors of the thesis's model at the report times, one named stream per quantity
+
+def _nav_status_name(cfg: ShipAis, ship_cfg: Ship) -> str:
+    """The navigation status's name: as configured, or from the speed (0 kn: at anchor) for ``auto``."""
+    if cfg.nav_status == "auto":
+        return "at_anchor" if ship_cfg.speed_kn == 0 else "under_way"
+    return cfg.nav_status
+
+
+def _interval_s(cfg: ShipAis, kin: dict, status_name: str) -> np.ndarray:
+    """Reporting interval on the kinematics grid, s: Class A by speed, turning and status; Class B by speed."""
+    if cfg.ais_class != "A":
+        return schedule.class_b_interval_s(kin["sog_kn"])
+    anchored = np.full(kin["sog_kn"].size, status_name in ("at_anchor", "moored"))
+    turning = np.abs(kin["rot_deg_per_min"]) > schedule.TURNING_DEG_PER_MIN
+    return schedule.class_a_interval_s(kin["sog_kn"], turning, anchored)
+
+
+def _reported_values(world: World, cfg: ShipAis, grid: np.ndarray, kin: dict, t: np.ndarray) -> dict:
+    """Position (lat, lon, deg), SOG (kn), COG and heading (deg) and ROT (deg/min) as reported at times ``t``.
+
+    The true values interpolated from the grid plus the thesis's errors, one named stream per
+    quantity (``ais.<mmsi>.<quantity>``), and the configured position offset.
+    """
+    s = world.scenario
+    noise = s.sensors.ais.noise
+
     def err(name, var_w, var_b, tau):
-        return white_plus_bias(stream(s.seed, f"ais.{mmsi}.{name}"), t, math.sqrt(var_w), math.sqrt(var_b), tau)
+        return white_plus_bias(stream(s.seed, f"ais.{cfg.mmsi}.{name}"), t, math.sqrt(var_w), math.sqrt(var_b), tau)
 
     east = np.interp(t, grid, kin["x"]) + cfg.position_offset_m[0] + err(
         "position_east", noise.position_measure_variance_m2, noise.position_bias_variance_m2,
@@ -132,46 +173,55 @@ def ship_messages(world, obj, ship_cfg) -> list[AisMessage]:
     rot = np.interp(t, grid, kin["rot_deg_per_min"]) + err("rot", noise.rot_measure_variance_deg2_pr_min2,
                                                          noise.rot_bias_variance_deg2_pr_min2,
                                                          noise.rot_bias_time_constant_sec)
-    accuracy = math.sqrt(noise.position_measure_variance_m2 + noise.position_bias_variance_m2) <= 10.0
-    start = s.start_time
-    seconds = np.floor((start.second + start.microsecond * 1e-6 + t) % 60.0)
-    iv = np.interp(t, grid, interval)
-    rate_changed = np.concatenate([[False], np.abs(np.diff(iv)) > 1e-6])
+    return {"lat": lat, "lon": lon, "sog": sog, "cog": cog, "heading": heading, "rot": rot}
 
+
+def _high_accuracy(noise: AisNoise) -> bool:
+    """The position accuracy flag: the error's standard deviation at most :data:`HIGH_ACCURACY_M`."""
+    return math.sqrt(noise.position_measure_variance_m2 + noise.position_bias_variance_m2) <= HIGH_ACCURACY_M
+
+
+def _position_reports(start: dt.datetime, cfg: ShipAis, status: int, t: np.ndarray, interval_s: np.ndarray,
+                      reported: dict, accuracy: bool) -> list[tuple[float, dict]]:
+    """``(t_s, pyais fields)`` of every position report: types 1/3 (Class A) or 18 (Class B)."""
+    seconds = np.floor((start.second + start.microsecond * 1e-6 + t) % 60.0)
+    rate_changed = np.concatenate([[False], np.abs(np.diff(interval_s)) > RATE_CHANGE_TOLERANCE_S])
+    lat, lon, sog, cog, heading, rot = (reported[k] for k in ("lat", "lon", "sog", "cog", "heading", "rot"))
     messages = []
     for k in range(t.size):  # one pyais field dict per transmission (pyais encodes message by message)
         if cfg.ais_class == "A":
-            data = fields.position_report(3 if rate_changed[k] else 1, mmsi, status, float(rot[k]), float(sog[k]),
+            data = fields.position_report(3 if rate_changed[k] else 1, cfg.mmsi, status, float(rot[k]), float(sog[k]),
                                           accuracy, float(lon[k]), float(lat[k]), float(cog[k]), float(heading[k]),
                                           float(seconds[k]))
         else:
-            data = fields.class_b_report(mmsi, float(sog[k]), accuracy, float(lon[k]), float(lat[k]), float(cog[k]),
-                                         float(heading[k]), float(seconds[k]))
+            data = fields.class_b_report(cfg.mmsi, float(sog[k]), accuracy, float(lon[k]), float(lat[k]),
+                                         float(cog[k]), float(heading[k]), float(seconds[k]))
         messages.append((float(t[k]), data))
+    return messages
 
-    # static data: at start (within the first 6 s) and every 6 min
+
+def _static_reports(cfg: ShipAis, obj: WorldObject, rng: np.random.Generator,
+                    duration_s: float) -> list[tuple[float, dict]]:
+    """``(t_s, pyais fields)`` of the static data: at start (within the first 6 s) and every 6 min.
+
+    Class A sends type 5; Class B type 24 part A and, one slot later, part B.
+    """
     name = cfg.name or obj.name
     length, beam = obj.length_m, obj.beam_m
-    t0 = float(np.round(rng.uniform(0.0, 6.0) / schedule.SLOT_S) * schedule.SLOT_S)
-    static_t = np.arange(t0, duration, schedule.STATIC_INTERVAL_S)
+    t0 = float(np.round(rng.uniform(0.0, FIRST_STATIC_WITHIN_S) / schedule.SLOT_S) * schedule.SLOT_S)
+    static_t = np.arange(t0, duration_s, schedule.STATIC_INTERVAL_S)
     if cfg.ais_class == "A":
-        ship_type = 70 if cfg.ship_type is None else cfg.ship_type
-        draught = min(0.06 * length, 25.5) if cfg.draught_m is None else cfg.draught_m
-        static = fields.static_report(mmsi, name, cfg.call_sign, ship_type, length, beam, draught, cfg.destination)
-        messages += [(float(ts), static) for ts in static_t]
-    else:
-        ship_type = 37 if cfg.ship_type is None else cfg.ship_type
-        part_a = fields.static_report_b(mmsi, 0, name, cfg.call_sign, ship_type, length, beam)
-        part_b = fields.static_report_b(mmsi, 1, name, cfg.call_sign, ship_type, length, beam)
-        messages += [(float(ts), part_a) for ts in static_t]
-        messages += [(float(ts + schedule.SLOT_S), part_b) for ts in static_t]
-    messages.sort(key=lambda m: (m[0], m[1]["msg_type"]))
-    first = "A" if rng.uniform() < 0.5 else "B"
-    other = {"A": "B", "B": "A"}
-    return [AisMessage(tm, mmsi, first if i % 2 == 0 else other[first], data) for i, (tm, data) in enumerate(messages)]
+        ship_type = DEFAULT_SHIP_TYPE_CLASS_A if cfg.ship_type is None else cfg.ship_type
+        draught = min(DRAUGHT_PER_LENGTH * length, MAX_DRAUGHT_M) if cfg.draught_m is None else cfg.draught_m
+        static = fields.static_report(cfg.mmsi, name, cfg.call_sign, ship_type, length, beam, draught, cfg.destination)
+        return [(float(ts), static) for ts in static_t]
+    ship_type = DEFAULT_SHIP_TYPE_CLASS_B if cfg.ship_type is None else cfg.ship_type
+    part_a = fields.static_report_b(cfg.mmsi, 0, name, cfg.call_sign, ship_type, length, beam)
+    part_b = fields.static_report_b(cfg.mmsi, 1, name, cfg.call_sign, ship_type, length, beam)
+    return [(float(ts), part_a) for ts in static_t] + [(float(ts + schedule.SLOT_S), part_b) for ts in static_t]
 
 
-def received_messages(world, messages: list[AisMessage], obj) -> list[AisMessage]:
+def received_messages(world: World, messages: list[AisMessage], obj: WorldObject) -> list[AisMessage]:
     """The transmissions of ``obj`` the own ship receives: transponder on, not dropped, in range."""
     s = world.scenario
     cfg = obj.ais
@@ -265,7 +315,7 @@ def write_ais_files(directory: Path, messages: list[AisMessage], start_time: dt.
     return n
 
 
-def render_ais(ctx) -> None:
+def render_ais(ctx: SensorContext) -> None:
     """The ``ais`` entry for :data:`raysim.render.SENSOR_RENDERERS`: writes ``ais/`` (:func:`write_ais_files`)."""
     world = ctx.world
     ships = {ship.name: ship for ship in world.scenario.ships}

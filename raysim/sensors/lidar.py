@@ -1,6 +1,6 @@
 """Velodyne HDL-32E on the own ship: raw packets (PCAP) and per-revolution sweeps (NPZ).
 
-The firing schedule is the sensor's (:mod:`raysim.sensors.hdl32e`): one laser every
+The firing schedule is the sensor's (:mod:`groundfloor.hdl32e`): one laser every
 1.152 us in DSR order, 46.08 us cycles, 12 cycles per packet (6 in dual-return
 mode). Every firing is cast from the sensor pose at its own instant -- the own
 ship's pose is evaluated at every cycle boundary and interpolated to each firing
@@ -20,20 +20,45 @@ from pathlib import Path
 
 import numpy as np
 
+from groundfloor import hdl32e
+from groundfloor.frames import mount_transform  # noqa: F401 (raysim.sensors.lidar.mount_transform)
+from groundfloor.recording import LIDAR_SWEEP
 from raysim.materials import material_index, material_table
-from raysim.pose import rotation_matrices
 from raysim.random_streams import stream
 from raysim.recording import nmea
-from raysim.recording.npz import write_npz
+from raysim.recording.npz import write_sweep
 from raysim.recording.staging import atomic_path
 from raysim.recording.velodyne import PcapWriter, encode_data_packets, encode_position_packet
 from raysim.scene import NO_HIT, SEA_ID, intersect_sea
 from raysim.sea import FoamField
-from raysim.sensors import hdl32e, lidar_physics as phys
+from raysim.sensors import lidar_physics as phys
 from raysim.sensors.carrier import CarrierScene
+from raysim.sensors.context import SensorContext
+from raysim.world import World
 
 SOURCE_OBJECT, SOURCE_SEA, SOURCE_WEATHER = 0, 1, 2
 FOAM_REFLECTANCE = 0.25  # whitecap foam at 905 nm, diffuse (unverified; bright in the visible, darker in NIR)
+#: Rays are cast this far past the maximum range, m, so that range noise can bring an echo just
+#: beyond it back in (the measured range is checked against the maximum after the noise).
+CAST_RANGE_MARGIN_M = 1.0
+#: Own-ship hits below this height above the waterline, m, may have the sea in front of them when
+#: the ship rolls or heaves; those beams are checked against the sea at each firing.
+WET_HIT_MAX_Z_M = 1.0
+#: Largest value of the packets' 16-bit distance field, 2 mm units (HDL-32E user manual, 131.07 m).
+MAX_DISTANCE_UNITS = 65535
+#: Diffuse reflectivity byte per unit of apparent reflectance (0..100,
+#: :func:`raysim.sensors.lidar_physics.reflectivity_byte`).
+REFLECTIVITY_BYTE_PER_UNIT_REFLECTANCE = 100
+#: Encoder azimuth steps (0.01 deg) to degrees.
+DEG_PER_CENTIDEG = 0.01
+#: Returns per firing in dual-return mode (last and strongest): a packet holds half as many cycles.
+DUAL_RETURNS = 2
+#: Slack of the firing-cycle count of the run, in cycles: a duration that is a whole number of
+#: cycles in decimal is not always one in binary floating point.
+CYCLE_COUNT_SLACK = 1e-9
+SECONDS_PER_HOUR = 3600.0
+MICROSECONDS_PER_SECOND = 1e6
+DEG_PER_TURN = 360.0
 
 
 @dataclass
@@ -54,11 +79,30 @@ class Firings:
     source: np.ndarray
 
 
-def mount_transform(mount) -> tuple[np.ndarray, np.ndarray]:
-    """Sensor-to-body rotation (3, 3) and translation (3,) of a mount (marine angles in, FLU out)."""
-    rotation = rotation_matrices(np.array([np.radians(-mount.yaw_deg)]), np.array([np.radians(-mount.pitch_deg)]),
-                                 np.array([np.radians(mount.roll_deg)]))[0]
-    return rotation, np.array([mount.x_m, mount.y_m, mount.z_m])
+@dataclass
+class _Rays:
+    """A chunk's N = F K rays in the world: origins (N, 3) m, unit directions (N, 3), firing times (N,) s."""
+
+    origins_m: np.ndarray
+    directions: np.ndarray
+    times_s: np.ndarray
+
+
+@dataclass
+class _Candidates:
+    """Candidate echoes of F firings, (F, E) each: E = K sub-rays (+ 1 weather false echo)."""
+
+    range_m: np.ndarray
+    power: np.ndarray
+    byte: np.ndarray
+    object_id: np.ndarray
+    source: np.ndarray
+
+    @classmethod
+    def empty(cls, f: int, e: int) -> _Candidates:
+        """No echo anywhere: infinite range, zero power, id -1."""
+        return cls(np.full((f, e), np.inf), np.zeros((f, e)), np.zeros((f, e), dtype=np.uint8),
+                   np.full((f, e), -1, dtype=np.int32), np.zeros((f, e), dtype=np.uint8))
 
 
 class LidarRenderer:
@@ -71,13 +115,13 @@ class LidarRenderer:
         The ray engine over the world's objects (sea included), own ship cast in its body frame.
     """
 
-    def __init__(self, world, scene: CarrierScene):
+    def __init__(self, world: World, scene: CarrierScene):
         self.world = world
         self.scene = scene
         s = world.scenario
         self.cfg = s.sensors.lidar
         self.dual = self.cfg.return_mode == "dual"
-        self.cycles_per_packet = hdl32e.BLOCKS_PER_PACKET // (2 if self.dual else 1)
+        self.cycles_per_packet = hdl32e.BLOCKS_PER_PACKET // (DUAL_RETURNS if self.dual else 1)
         self.mount_rotation, self.mount_translation = mount_transform(self.cfg.mount)
         self.alpha = phys.extinction_per_m(s.environment.fog_visibility_m, s.environment.rain_mm_per_h)
         self.threshold = phys.detection_threshold(self.cfg.detection_reflectance)
@@ -90,7 +134,7 @@ class LidarRenderer:
         self.offsets = phys.sub_ray_offsets(self.cfg.sub_rays, self.cfg.beam_divergence_mrad * 1e-3)
         self.own_table = self._own_ship_table() if self.offsets.shape[0] == 1 else None
         self.start_unix_s = s.start_time.timestamp()
-        self.n_cycles = int(np.floor(s.duration_s / hdl32e.CYCLE_DT_S + 1e-9))
+        self.n_cycles = int(np.floor(s.duration_s / hdl32e.CYCLE_DT_S + CYCLE_COUNT_SLACK))
         self.n_packets = self.n_cycles // self.cycles_per_packet
         #: (scenario seconds, wall seconds) of each chunk of the last run (benchmarks read it)
         self.chunk_wall_s: list[tuple[float, float]] = []
@@ -108,12 +152,13 @@ class LidarRenderer:
         """
         if self.scene is None or self.scene.carrier is None:
             return None
-        az = np.broadcast_to(np.arange(36000, dtype=np.uint16)[:, None], (36000, hdl32e.N_LASERS))
+        steps = hdl32e.CENTIDEG_PER_TURN
+        az = np.broadcast_to(np.arange(steps, dtype=np.uint16)[:, None], (steps, hdl32e.N_LASERS))
         origins, directions = self._sensor_rays(az)
         n = origins.shape[0] * hdl32e.N_LASERS
         o_b = origins.reshape(n, 3) @ self.mount_rotation.T + self.mount_translation
         d_b = directions.reshape(n, 3) @ self.mount_rotation.T
-        hits = self.scene.carrier_hits(o_b, d_b, max_range_m=self.cfg.range_max_m + 1.0)
+        hits = self.scene.carrier_hits(o_b, d_b, max_range_m=self.cfg.range_max_m + CAST_RANGE_MARGIN_M)
         hit = hits.object_id != NO_HIT
         cos_inc = np.abs(np.einsum("ij,ij->i", hits.normal, d_b))
         mat = np.where(hit, hits.material, 0)
@@ -125,7 +170,7 @@ class LidarRenderer:
             "power": np.where(hit, phys.echo_power(reflectance * cos_inc, rng, self.alpha), 0.0).astype(np.float32),
             "byte": phys.reflectivity_byte(reflectance, cos_inc, self.materials["retroreflective"][mat] & hit),
             # hits near or below the waterline: the sea may come first when the ship rolls or heaves
-            "wet": hit & (hit_z < 1.0),
+            "wet": hit & (hit_z < WET_HIT_MAX_Z_M),
             "object_id": self.world.own_ship.object_id,
         }
 
@@ -188,41 +233,65 @@ class LidarRenderer:
         n = f * k
         origins_s, directions_s = self._sensor_rays(firing_azimuth)
         o_w, d_w, t_firing = self._world_rays(cycle_time_s, origins_s, directions_s)
-        o_w, d_w = o_w.reshape(n, 3), d_w.reshape(n, 3)
-        times = np.repeat(t_firing.reshape(-1), k) if k > 1 else t_firing.reshape(-1)
-        max_range = self.cfg.range_max_m + 1.0
+        rays = _Rays(o_w.reshape(n, 3), d_w.reshape(n, 3),
+                     np.repeat(t_firing.reshape(-1), k) if k > 1 else t_firing.reshape(-1))
         # candidate echoes per firing: K sub-rays and, in weather, one false echo near the sensor
-        e = k + (1 if self.alpha > 0 else 0)
-        cand_r = np.full((f, e), np.inf)
-        cand_p = np.zeros((f, e))
-        cand_b = np.zeros((f, e), dtype=np.uint8)
-        cand_id = np.full((f, e), -1, dtype=np.int32)
-        cand_src = np.zeros((f, e), dtype=np.uint8)
+        cand = _Candidates.empty(f, k + (1 if self.alpha > 0 else 0))
         if self.own_table is not None:
-            # the own ship from the beam table; only the other rays go into the world
-            t = self.own_table
-            key = firing_azimuth.reshape(-1).astype(np.int64) * hdl32e.N_LASERS + np.tile(np.arange(hdl32e.N_LASERS), c)
-            r_own = t["range_m"][key].astype(np.float64)
-            on_own = np.isfinite(r_own)
-            wet = np.flatnonzero(t["wet"][key])
-            if wet.size:
-                on_own[wet] &= ~(intersect_sea(o_w[wet, 2], d_w[wet, 2]) < r_own[wet])
-            own = np.flatnonzero(on_own)
-            cand_r[own, 0] = r_own[own]
-            cand_p[own, 0] = t["power"][key[own]]
-            cand_b[own, 0] = t["byte"][key[own]]
-            cand_id[own, 0] = t["object_id"]
-            free = np.flatnonzero(~on_own)
-            hits = self.scene.world.cast(o_w[free], d_w[free], times[free], max_range_m=max_range)
-            own_body = None
+            hits, free, own_body = self._cast_past_own_ship(cand, rays, firing_azimuth)
         else:
-            o_b = origins_s.reshape(n, 3) @ self.mount_rotation.T + self.mount_translation
-            d_b = directions_s.reshape(n, 3) @ self.mount_rotation.T
-            hits, on_carrier = self.scene.cast(o_w, d_w, times, o_b, d_b, max_range_m=max_range)
-            free = np.arange(n)
-            own_body = (on_carrier, d_b)
+            hits, free, own_body = self._cast_with_own_ship(rays, origins_s, directions_s)
+        self._world_echoes(cand, rays, hits, free, own_body, k)
+        if self.alpha > 0:
+            self._false_echoes(cand, f, k)
+        units, refl, oid, src = self._returns(cand, f)
+        shape = (units.shape[0], c, hdl32e.N_LASERS)
+        to_c = lambda a: np.moveaxis(a.reshape(shape), 0, 1)  # noqa: E731
+        return Firings(cycle_time_s, block_azimuth, firing_azimuth, to_c(units), to_c(refl), to_c(oid), to_c(src))
 
-        # physics on the rays that hit something in the world (the sky is a large part of a sweep)
+    def _cast_past_own_ship(self, cand: _Candidates, rays: _Rays, firing_azimuth: np.ndarray):
+        """The own ship's echoes from the beam table into candidate 0; only the other rays go into the world.
+
+        Returns the world's hits, the indices of the rays cast into the world, and None (no
+        own-ship body-frame hits among them).
+        """
+        t = self.own_table
+        azimuth = firing_azimuth.reshape(-1).astype(np.int64)
+        key = azimuth * hdl32e.N_LASERS + np.tile(np.arange(hdl32e.N_LASERS), azimuth.size // hdl32e.N_LASERS)
+        r_own = t["range_m"][key].astype(np.float64)
+        on_own = np.isfinite(r_own)
+        wet = np.flatnonzero(t["wet"][key])
+        if wet.size:
+            on_own[wet] &= ~(intersect_sea(rays.origins_m[wet, 2], rays.directions[wet, 2]) < r_own[wet])
+        own = np.flatnonzero(on_own)
+        cand.range_m[own, 0] = r_own[own]
+        cand.power[own, 0] = t["power"][key[own]]
+        cand.byte[own, 0] = t["byte"][key[own]]
+        cand.object_id[own, 0] = t["object_id"]
+        free = np.flatnonzero(~on_own)
+        hits = self.scene.world.cast(rays.origins_m[free], rays.directions[free], rays.times_s[free],
+                                     max_range_m=self.cfg.range_max_m + CAST_RANGE_MARGIN_M)
+        return hits, free, None
+
+    def _cast_with_own_ship(self, rays: _Rays, origins_s: np.ndarray, directions_s: np.ndarray):
+        """Every ray cast, the own ship in its body frame (sub-rays: no beam table).
+
+        Returns the hits, the indices of all rays, and ``(on_carrier, body-frame directions)``.
+        """
+        n = rays.origins_m.shape[0]
+        o_b = origins_s.reshape(n, 3) @ self.mount_rotation.T + self.mount_translation
+        d_b = directions_s.reshape(n, 3) @ self.mount_rotation.T
+        hits, on_carrier = self.scene.cast(rays.origins_m, rays.directions, rays.times_s, o_b, d_b,
+                                           max_range_m=self.cfg.range_max_m + CAST_RANGE_MARGIN_M)
+        return hits, np.arange(n), (on_carrier, d_b)
+
+    def _world_echoes(self, cand: _Candidates, rays: _Rays, hits, free: np.ndarray, own_body, k: int) -> None:
+        """Echo range, power, byte, id and source of the rays that hit something, into the candidates.
+
+        Physics only on those rays (the sky is a large part of a sweep); calm sea is a mirror
+        (nothing comes back), foam a diffuse reflector.
+        """
+        o_w, d_w, times = rays.origins_m, rays.directions, rays.times_s
         hit_local = np.flatnonzero(hits.object_id != NO_HIT)
         h = free[hit_local]
         r_h = hits.range_m[hit_local]
@@ -243,28 +312,37 @@ class LidarRenderer:
             # foam is looked up only where a foam echo could be detected at all
             could = np.nonzero(sea & (phys.echo_power(FOAM_REFLECTANCE * cos_h, r_h, self.alpha) >= self.threshold))[0]
             if could.size:
-                rays = h[could]
-                x = o_w[rays, 0] + r_h[could] * d_w[rays, 0]
-                y = o_w[rays, 1] + r_h[could] * d_w[rays, 1]
-                foam = self.foam.is_foam(x, y, times[rays])
+                on_sea = h[could]
+                x = o_w[on_sea, 0] + r_h[could] * d_w[on_sea, 0]
+                y = o_w[on_sea, 1] + r_h[could] * d_w[on_sea, 1]
+                foam = self.foam.is_foam(x, y, times[on_sea])
                 reflectance[could[foam]] = FOAM_REFLECTANCE
         power_h = phys.echo_power(reflectance * cos_h, r_h, self.alpha) / k
         row, col = h // k, h % k
-        cand_r[row, col] = r_h
-        cand_p[row, col] = power_h
-        cand_b[row, col] = phys.reflectivity_byte(reflectance, cos_h, retro)
-        cand_id[row, col] = np.where(sea, -1, obj_h)
-        cand_src[row, col] = source
-        if self.alpha > 0:
-            p_false = 1.0 - np.exp(-self.alpha * phys.FALSE_ECHO_WINDOW_M)
-            has = self.weather_rng.random(f) < p_false
-            r_false = self.cfg.range_min_m + self.weather_rng.exponential(phys.FALSE_ECHO_MEAN_RANGE_M, f)
-            has &= r_false < phys.FALSE_ECHO_WINDOW_M
-            cand_r[has, k] = r_false[has]
-            cand_p[has, k] = phys.echo_power(np.full(has.sum(), phys.FALSE_ECHO_REFLECTANCE), r_false[has], self.alpha)
-            cand_b[has, k] = round(100 * phys.FALSE_ECHO_REFLECTANCE)
-            cand_src[has, k] = SOURCE_WEATHER
-        echoes = phys.select_echoes(cand_r, cand_p, self.threshold)
+        cand.range_m[row, col] = r_h
+        cand.power[row, col] = power_h
+        cand.byte[row, col] = phys.reflectivity_byte(reflectance, cos_h, retro)
+        cand.object_id[row, col] = np.where(sea, -1, obj_h)
+        cand.source[row, col] = source
+
+    def _false_echoes(self, cand: _Candidates, f: int, k: int) -> None:
+        """Weather's false echoes near the sensor (fog droplets, rain drops) into candidate column ``k``."""
+        p_false = 1.0 - np.exp(-self.alpha * phys.FALSE_ECHO_WINDOW_M)
+        has = self.weather_rng.random(f) < p_false
+        r_false = self.cfg.range_min_m + self.weather_rng.exponential(phys.FALSE_ECHO_MEAN_RANGE_M, f)
+        has &= r_false < phys.FALSE_ECHO_WINDOW_M
+        cand.range_m[has, k] = r_false[has]
+        cand.power[has, k] = phys.echo_power(np.full(has.sum(), phys.FALSE_ECHO_REFLECTANCE), r_false[has], self.alpha)
+        cand.byte[has, k] = round(REFLECTIVITY_BYTE_PER_UNIT_REFLECTANCE * phys.FALSE_ECHO_REFLECTANCE)
+        cand.source[has, k] = SOURCE_WEATHER
+
+    def _returns(self, cand: _Candidates, f: int):
+        """The returns the sensor reports per firing: (R, F) distance units, reflectivity bytes, ids, sources.
+
+        Echoes are grouped and picked by the return mode (R = 2 in dual mode), range noise added,
+        the range quantised to 2 mm units and kept within the sensor's range.
+        """
+        echoes = phys.select_echoes(cand.range_m, cand.power, self.threshold)
         strongest, last, group_r, group_id = echoes.strongest, echoes.last, echoes.group_range, echoes.group
         picks = [last, phys.dual_pick(echoes)] if self.dual else [last if self.cfg.return_mode == "last" else strongest]
         n_ret = len(picks)
@@ -279,12 +357,13 @@ class LidarRenderer:
             if self.cfg.range_noise_m > 0:
                 measured = measured + self.noise_rng.normal(0.0, self.cfg.range_noise_m, rows.size)
             q = np.round(measured / hdl32e.DISTANCE_UNIT_M)
-            ok = (measured >= self.cfg.range_min_m) & (measured <= self.cfg.range_max_m) & (q >= 1) & (q <= 65535)
+            ok = ((measured >= self.cfg.range_min_m) & (measured <= self.cfg.range_max_m) & (q >= 1)
+                  & (q <= MAX_DISTANCE_UNITS))
             rows, cols = rows[ok], cols[ok]
             units[i, rows] = q[ok]
-            refl[i, rows] = cand_b[rows, cols]
-            oid[i, rows] = cand_id[rows, cols]
-            src[i, rows] = cand_src[rows, cols]
+            refl[i, rows] = cand.byte[rows, cols]
+            oid[i, rows] = cand.object_id[rows, cols]
+            src[i, rows] = cand.source[rows, cols]
         if self.dual:  # a single echo group: both blocks carry the same measurement
             rows = np.arange(f)
             same = (group_id[rows, np.maximum(picks[0], 0)] == group_id[rows, np.maximum(picks[1], 0)]) & (units[0] > 0)
@@ -292,9 +371,7 @@ class LidarRenderer:
             refl[1] = np.where(same, refl[0], refl[1])
             oid[1] = np.where(same, oid[0], oid[1])
             src[1] = np.where(same, src[0], src[1])
-        shape = (n_ret, c, hdl32e.N_LASERS)
-        to_c = lambda a: np.moveaxis(a.reshape(shape), 0, 1)  # noqa: E731
-        return Firings(cycle_time_s, block_azimuth, firing_azimuth, to_c(units), to_c(refl), to_c(oid), to_c(src))
+        return units, refl, oid, src
 
     # ------------------------------------------------------------------ outputs
 
@@ -319,7 +396,7 @@ class LidarRenderer:
             "intensity": fire.reflectivity[cc, rr, jj].astype(np.uint8),
             "ring": hdl32e.RING[jj],
             "time": fire.cycle_time_s[cc] + jj * hdl32e.FIRING_DT_S,
-            "azimuth_deg": (az.astype(np.float64) * 0.01).astype(np.float32),
+            "azimuth_deg": (az.astype(np.float64) * DEG_PER_CENTIDEG).astype(np.float32),
             "object_id": fire.object_id[cc, rr, jj].astype(np.int32),
             "return_source": fire.source[cc, rr, jj].astype(np.uint8),
             "return_index": rr.astype(np.uint8),
@@ -330,14 +407,15 @@ class LidarRenderer:
         """(P, 1206) uint8 data packets of a chunk (C a multiple of the cycles per packet)."""
         c = fire.cycle_time_s.shape[0]
         p = c // self.cycles_per_packet
+        blocks, lasers = hdl32e.BLOCKS_PER_PACKET, hdl32e.N_LASERS
         if self.dual:
-            az = np.repeat(fire.block_azimuth, 2).reshape(p, 12)
-            dist = fire.distance_units.reshape(p, 12, 32)  # (C, 2, 32): blocks last, strongest
-            refl = fire.reflectivity.reshape(p, 12, 32)
+            az = np.repeat(fire.block_azimuth, DUAL_RETURNS).reshape(p, blocks)
+            dist = fire.distance_units.reshape(p, blocks, lasers)  # (C, 2, 32): blocks last, strongest
+            refl = fire.reflectivity.reshape(p, blocks, lasers)
         else:
-            az = fire.block_azimuth.reshape(p, 12)
-            dist = fire.distance_units[:, 0].reshape(p, 12, 32)
-            refl = fire.reflectivity[:, 0].reshape(p, 12, 32)
+            az = fire.block_azimuth.reshape(p, blocks)
+            dist = fire.distance_units[:, 0].reshape(p, blocks, lasers)
+            refl = fire.reflectivity[:, 0].reshape(p, blocks, lasers)
         first = fire.cycle_time_s[:: self.cycles_per_packet]
         stamp = self._hour_microseconds(first)
         mode = hdl32e.RETURN_MODE_BYTE[self.cfg.return_mode]
@@ -346,7 +424,7 @@ class LidarRenderer:
     def _hour_microseconds(self, t_s: np.ndarray) -> np.ndarray:
         """Microseconds since the top of the UTC hour (the packet timestamp field)."""
         unix = self.start_unix_s + np.asarray(t_s, dtype=np.float64)
-        return np.round(np.mod(unix, 3600.0) * 1e6).astype(np.int64).astype(np.uint32)
+        return np.round(np.mod(unix, SECONDS_PER_HOUR) * MICROSECONDS_PER_SECOND).astype(np.int64).astype(np.uint32)
 
     def position_packet(self, t_s: float) -> bytes:
         """The 8308 packet at time t: timestamp and a $GPRMC of the own ship."""
@@ -383,10 +461,11 @@ class LidarRenderer:
                 cycles = k0 + np.arange(packets_here * self.cycles_per_packet)
                 t = cycles * hdl32e.CYCLE_DT_S
                 block_az = hdl32e.block_azimuth_centideg(t, self.cfg.rotation_hz, self.cfg.azimuth0_deg)
-                az_blocks = np.repeat(block_az, 2).reshape(-1, 12) if self.dual else block_az.reshape(-1, 12)
+                blocks = hdl32e.BLOCKS_PER_PACKET
+                az_blocks = (np.repeat(block_az, DUAL_RETURNS) if self.dual else block_az).reshape(-1, blocks)
                 firing_az = hdl32e.decoder_azimuths_centideg(az_blocks, dual=self.dual)
                 firing_az = firing_az[:, ::2] if self.dual else firing_az
-                fire = self.measure(t, block_az, firing_az.reshape(-1, 32))
+                fire = self.measure(t, block_az, firing_az.reshape(-1, hdl32e.N_LASERS))
                 payloads = self.packets(fire)
                 sent = t[:: self.cycles_per_packet] + self.cycles_per_packet * hdl32e.CYCLE_DT_S
                 # position packets due within this chunk go in time order with the data packets
@@ -398,7 +477,7 @@ class LidarRenderer:
                 self._write_in_order(pcap, payloads, sent, position_times)
                 counts["packets"] += payloads.shape[0]
                 counts["position_packets"] += len(position_times)
-                revolution = np.floor((self.cfg.azimuth0_deg + 360.0 * self.cfg.rotation_hz * t) / 360.0).astype(np.int64)
+                revolution = np.floor((self.cfg.azimuth0_deg + DEG_PER_TURN * self.cfg.rotation_hz * t) / DEG_PER_TURN).astype(np.int64)
                 pts, cycle_of_point = self.points(fire)
                 point_rev = revolution[cycle_of_point]
                 for rev in np.unique(revolution):
@@ -409,7 +488,7 @@ class LidarRenderer:
                 self.chunk_wall_s.append((t[-1] + hdl32e.CYCLE_DT_S - t[0], time.perf_counter() - chunk_started))
             # the last revolution is written only if it is complete
             t_next = self.n_packets * self.cycles_per_packet * hdl32e.CYCLE_DT_S
-            if np.floor((self.cfg.azimuth0_deg + 360.0 * self.cfg.rotation_hz * t_next) / 360.0) > current_rev:
+            if np.floor((self.cfg.azimuth0_deg + DEG_PER_TURN * self.cfg.rotation_hz * t_next) / DEG_PER_TURN) > current_rev:
                 self._flush(sweeps_dir, current_rev, pending, counts)
         return counts
 
@@ -430,12 +509,12 @@ class LidarRenderer:
 
     def _flush(self, sweeps_dir: Path, rev: int, pending: list[dict], counts: dict) -> None:
         arrays = {k: np.concatenate([p[k] for p in pending]) for k in pending[0]}
-        write_npz(sweeps_dir / f"{rev:06d}.npz", arrays)
+        write_sweep(sweeps_dir, rev, LIDAR_SWEEP, arrays)
         counts["sweeps"] += 1
         counts["points"] += int(arrays["x"].shape[0])
 
 
-def render_lidar(ctx) -> None:
+def render_lidar(ctx: SensorContext) -> None:
     """The ``lidar`` entry of :data:`raysim.render.SENSOR_RENDERERS`."""
     scene = ctx.scene()
     renderer = LidarRenderer(ctx.world, scene)
