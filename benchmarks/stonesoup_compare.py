@@ -344,6 +344,7 @@ def run_stonesoup_all(recording: Path, events: list, stream: DetectionStream, wo
     write_jsonl(out / "tdm" / "detected_targets.jsonl",
                 [{k: v for k, v in dict(r, sources=list(STONESOUP_TRACKERS[central])).items() if k != "sensor"}
                  for r in records if r["sensor"] == central])
+    records.sort(key=lambda r: r["t"])  # the format's time order (tdm evaluate refuses lines going back in time)
     write_jsonl(out / "tdm" / "sensor_tracks.jsonl", records)
     m = evaluate(out)
     return {name: _pick(m["per_sensor"].get(name, {})) for name in names}, walls
