@@ -21,7 +21,7 @@ and the output files.
 from __future__ import annotations
 
 import shutil
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Callable, Iterable
 
@@ -33,65 +33,17 @@ from tdm.fusion import Fuser, FusionConfig
 from tdm.io import read_manifest, read_scenario
 from tdm.messages import jsonl_writer, target_record
 from tdm.recording.scenario import MAX_UPDATE_RATE_HZ
+from tdm.run_config import FUSION_RULES, LIDAR_SOURCES, TdmConfig
 from tdm.scans import DetectionStream, start_time_unix_s
-from tdm.tracker import AisTracker, AisTrackerConfig, PositionTracker, TrackerConfig
+from tdm.tracker import AisTracker, PositionTracker, TrackerConfig
 from tdm.workers import BATCH_SCANS, LIDAR_FIELDS, RADAR_FIELDS
 
 __all__ = ["BATCH_SCANS", "DetectionStream", "FUSION_RULES", "LIDAR_FIELDS", "LIDAR_SOURCES", "RADAR_FIELDS",
            "RunResult", "TdmConfig", "run_tdm", "start_time_unix_s"]
 
-LIDAR_SOURCES = ("auto", "npz", "pcap")
-FUSION_RULES = ("simple", "ci")
-#: Output rate when scenario.yaml states none, Hz (thesis TDM_update_rate_Hz).
-DEFAULT_UPDATE_RATE_HZ = 1.0
 #: Tolerance of the epoch count ``floor(duration x rate)``: a product that falls a rounding error
 #: short of a whole number still counts its last epoch.
 _EPOCH_COUNT_TOLERANCE = 1e-9
-
-
-@dataclass(frozen=True)
-class TdmConfig:
-    """Everything ``tdm run`` can be told (defaults from the recording's scenario.yaml).
-
-    Attributes
-    ----------
-    update_rate_hz : float
-        Output rate of detected targets (scenario ``tdm.update_rate_hz``; thesis TDM_update_rate_Hz).
-    fusion : str
-        ``simple`` (thesis eq. 3.2) or ``ci`` (covariance intersection).
-    lidar_source : str
-        ``npz`` sweeps, ``pcap``, or ``auto`` (NPZ when present, else the PCAP).
-    workers : int
-        Front-end worker processes (0: in this process).
-    """
-
-    update_rate_hz: float = DEFAULT_UPDATE_RATE_HZ
-    fusion: str = "simple"
-    lidar_source: str = "auto"
-    workers: int = 2
-    lidar_tracker: TrackerConfig = field(default_factory=lambda: TrackerConfig(
-        confirm_m=6, confirm_n=10, coast_s=2.0, position_floor_m2=1.0, max_range_m=100.0))
-    radar_tracker: TrackerConfig = field(default_factory=lambda: TrackerConfig(
-        confirm_m=3, confirm_n=4, coast_s=8.0, position_floor_m2=4.0, max_range_m=1852.0,
-        merge_distance_m=25.0, cross_section_sigma_m2=300.0,
-        # a radar track's second plot is looked for within 4 m/s (8 kn) of standing still, at most
-        # 15 m/s (29 kn): sea-clutter pairs far apart no longer start tracks (busy_open_sea, 300 s:
-        # 4.2 -> 3.2 false targets a minute)
-        init_speed_sigma_mps=4.0, max_speed_mps=15.0,
-        # plots barely over the clutter count half a hit, plots well over it 1.5 (TrackerConfig; busy_open_sea,
-        # 300 s: 3.2 -> 0.8 false targets a minute, and strong new objects confirm a scan sooner)
-        weak_below_db=13.0, strong_from_db=15.0,
-        # a plot narrower than the beam paints is a sea spike, however strong: a weak hit (Detections.beam_fill;
-        # busy_open_sea seeds 7-11, 300 s: 0.6-1.0 -> 0-0.4 false targets a minute)
-        min_beam_fill=0.5))
-    ais_tracker: AisTrackerConfig = field(default_factory=AisTrackerConfig)
-    fusion_config: FusionConfig = field(default_factory=FusionConfig)
-
-    @classmethod
-    def for_recording(cls, recording: Path, **changes) -> "TdmConfig":
-        """The defaults with ``update_rate_hz`` from the recording's scenario.yaml, then ``changes``."""
-        rate = float((read_scenario(recording).get("tdm") or {}).get("update_rate_hz", DEFAULT_UPDATE_RATE_HZ))
-        return cls(**{"update_rate_hz": rate, **changes})
 
 
 @dataclass
@@ -125,10 +77,9 @@ class _EpochTimes:
 class _Tracking:
     """A run's trackers (one per sensor) and fuser, and what they have written."""
 
-    def __init__(self, stream: DetectionStream, scenario: dict, config: TdmConfig):
-        sensors_cfg = scenario.get("sensors") or {}
-        lidar_tcfg = _with_range(config.lidar_tracker, (sensors_cfg.get("lidar") or {}).get("range_max_m"))
-        radar_tcfg = _with_range(config.radar_tracker, (sensors_cfg.get("radar") or {}).get("range_m"))
+    def __init__(self, stream: DetectionStream, config: TdmConfig):
+        lidar_tcfg = _with_range(config.lidar_tracker, stream.description.lidar.range_max_m)
+        radar_tcfg = _with_range(config.radar_tracker, stream.description.radar.range_m)
         self.ownship = stream.ownship
         self.trackers = {"lidar": PositionTracker("lidar", lidar_tcfg), "radar": PositionTracker("radar", radar_tcfg)}
         self.ais = AisTracker(config.ais_tracker)
@@ -223,7 +174,7 @@ def run_tdm(recording: Path, out_dir: Path | None = None, config: TdmConfig | No
     duration_s = float(manifest.get("duration_s") or stream.nav["t"][-1])
     epochs = _EpochTimes(int(np.floor(duration_s * config.update_rate_hz + _EPOCH_COUNT_TOLERANCE)),
                          config.update_rate_hz)
-    tracking = _Tracking(stream, scenario, config)
+    tracking = _Tracking(stream, config)
     events = stream.events()
     bar = None
     if progress:
@@ -244,7 +195,7 @@ def run_tdm(recording: Path, out_dir: Path | None = None, config: TdmConfig | No
                      dict(stats.warnings))
 
 
-def _with_range(cfg: TrackerConfig, range_m) -> TrackerConfig:
+def _with_range(cfg: TrackerConfig, range_m: float | None) -> TrackerConfig:
     if range_m is None:
         return cfg
     return replace(cfg, max_range_m=float(range_m))

@@ -9,22 +9,21 @@ from __future__ import annotations
 
 import heapq
 from pathlib import Path
-from typing import TYPE_CHECKING, Iterator
+from typing import Iterator
 
 from tdm.detections import ReadStats
 from tdm.errors import RecordingError
-from tdm.frames import Mount, OwnshipTrack
+from tdm.frames import OwnshipTrack
 from tdm.frontend.ais import read_ais
 from tdm.frontend.lidar import LidarFrontEndConfig
 from tdm.frontend.radar import RadarFrontEndConfig
 from tdm.io import read_manifest, read_ownship, read_scenario
 from tdm.recording.files import directory_present, is_present, regular_file
 from tdm.recording.manifest import start_time_unix_s as _start_time_unix_s
+from tdm.recording.description import RecordingDescription, describe
 from tdm.recording.sweep_files import list_sweeps, sweep_window_s
+from tdm.run_config import TdmConfig
 from tdm.workers import detections_in_time_order
-
-if TYPE_CHECKING:
-    from tdm.pipeline import TdmConfig
 
 __all__ = ["DetectionStream", "interleaved", "start_time_unix_s"]
 
@@ -64,27 +63,27 @@ def _lidar_jobs(rec: Path, lidar_source: str, manifest: dict, stats: ReadStats) 
     return None
 
 
-def _scan_jobs(recording: Path, config: TdmConfig, manifest: dict, scenario: dict, stats: ReadStats) -> Jobs:
+def _scan_jobs(recording: Path, config: TdmConfig, manifest: dict, description: RecordingDescription,
+               stats: ReadStats) -> Jobs:
     """Per sensor: (iterator of front-end jobs in time order, scan period in s)."""
     rec = Path(recording)
-    sensors = scenario.get("sensors") or {}
     jobs: Jobs = {}
-    lidar_period_s = 1.0 / float((sensors.get("lidar") or {}).get("rotation_hz", DEFAULT_LIDAR_ROTATION_HZ))
+    lidar_period_s = description.lidar.period_s or 1.0 / DEFAULT_LIDAR_ROTATION_HZ
     lidar = _lidar_jobs(rec, config.lidar_source, manifest, stats)
     if lidar is not None:
         jobs["lidar"] = (lidar, lidar_period_s)
     radar_dir = rec / "radar" / "sweeps"
     if directory_present(radar_dir):
-        radar_period_s = SECONDS_PER_MINUTE / float((sensors.get("radar") or {}).get("rpm", DEFAULT_RADAR_RPM))
+        radar_period_s = description.radar.period_s or SECONDS_PER_MINUTE / DEFAULT_RADAR_RPM
         jobs["radar"] = ((("radar", p) for p in list_sweeps(radar_dir, "radar", stats)), radar_period_s)
     return jobs
 
 
-def _sweep_limits(manifest: dict, scenario: dict) -> dict[str, tuple[tuple[float, float], dict[str, int] | None]]:
+def _sweep_limits(description: RecordingDescription) -> dict[str, tuple[tuple[float, float], dict[str, int] | None]]:
     """Per sensor: the times its sweeps may hold (s) and the axis lengths scenario.yaml states (radar)."""
-    window_s = sweep_window_s(float(manifest["duration_s"]))
-    radar = (scenario.get("sensors") or {}).get("radar") or {}
-    expected = {axis: int(radar[axis]) for axis in ("spokes", "samples") if radar.get(axis) is not None}
+    window_s = sweep_window_s(description.duration_s)
+    radar = description.radar
+    expected = {axis: n for axis, n in (("spokes", radar.spokes), ("samples", radar.samples)) if n is not None}
     return {"lidar": (window_s, None), "radar": (window_s, expected or None)}
 
 
@@ -118,6 +117,9 @@ class DetectionStream:
         ownship.jsonl columns.
     reports : list of AisReport
     static : dict of int to AisStatic
+    description : RecordingDescription
+        The recording's typed description (:func:`tdm.recording.description.describe`): its
+        duration, the sensors' periods, ranges and mounts, read once for the whole run.
     """
 
     def __init__(self, recording: Path, config: TdmConfig, stats: ReadStats, manifest: dict | None = None,
@@ -128,14 +130,12 @@ class DetectionStream:
         self.config, self.stats = config, stats
         self.nav = read_ownship(rec, stats)
         self.ownship = OwnshipTrack(self.nav)
-        sensors_cfg = scenario.get("sensors") or {}
+        self.description = describe(rec, manifest, scenario)
         lidar_cfg = LidarFrontEndConfig.from_scenario(scenario)
         radar_cfg = RadarFrontEndConfig.from_scenario(scenario)
-        lidar_mount = Mount.from_dict((sensors_cfg.get("lidar") or {}).get("mount"))
-        radar_mount = Mount.from_dict((sensors_cfg.get("radar") or {}).get("mount"))
-        self._initargs = (self.ownship, lidar_mount, lidar_cfg, radar_mount, radar_cfg,
-                          _sweep_limits(manifest, scenario))
-        self._jobs = _scan_jobs(rec, config, manifest, scenario, stats)
+        self._initargs = (self.ownship, self.description.lidar.mount, lidar_cfg, self.description.radar.mount,
+                          radar_cfg, _sweep_limits(self.description))
+        self._jobs = _scan_jobs(rec, config, manifest, self.description, stats)
         ais_path = rec / "ais" / "ais.nmea"
         self.reports, self.static = [], {}
         has_ais = is_present(ais_path)

@@ -9,6 +9,7 @@ import math
 from dataclasses import dataclass
 from typing import Literal
 
+from groundfloor.recording import LidarDescription
 from tdm.frames import Mount
 
 __all__ = ["HDL32E_FIRING_CYCLE_S", "LINK_WINDOW_CYCLES", "LidarFrontEndConfig", "lidar_mount_from_scenario"]
@@ -158,13 +159,11 @@ class LidarFrontEndConfig:
             values["ownship_length_m"] = float(own["length_m"])
         if own.get("beam_m") is not None:
             values["ownship_beam_m"] = float(own["beam_m"])
-        sensors = scenario.get("sensors") or {}
-        lidar = sensors.get("lidar") or {}
-        for key, name in (("range_min_m", "range_min_m"), ("range_max_m", "range_max_m"),
-                          ("rotation_hz", "rotation_hz"), ("beam_divergence_mrad", "beam_divergence_mrad")):
-            if lidar.get(key) is not None:
-                values[name] = float(lidar[key])
-        nav = sensors.get("nav") or {}
+        lidar = LidarDescription.from_scenario(scenario)
+        for name in ("range_min_m", "range_max_m", "rotation_hz", "beam_divergence_mrad"):
+            if getattr(lidar, name) is not None:
+                values[name] = getattr(lidar, name)
+        nav = (scenario.get("sensors") or {}).get("nav") or {}
         if nav.get("enabled", True) and any(k in nav for k in ("position_noise_m", "position_bias_m")):
             values["nav_position_sigma_m"] = math.hypot(float(nav.get("position_noise_m", 0.0)),
                                                         float(nav.get("position_bias_m", 0.0)))
@@ -181,5 +180,6 @@ class LidarFrontEndConfig:
 
 
 def lidar_mount_from_scenario(scenario: dict) -> Mount:
-    """The LiDAR's mount (``sensors.lidar.mount``) of a resolved ``scenario.yaml`` dict."""
-    return Mount.from_dict(((scenario.get("sensors") or {}).get("lidar") or {}).get("mount"))
+    """The LiDAR's mount (``sensors.lidar.mount``) of a resolved ``scenario.yaml`` dict
+    (:class:`groundfloor.recording.LidarDescription`)."""
+    return LidarDescription.from_scenario(scenario).mount

@@ -78,10 +78,10 @@ from scipy import ndimage
 
 from tdm.detections import Detections
 from tdm.frames import Mount, OwnshipTrack
-from tdm.frontend.radar_cfar import (VIDEO_LEVELS, _cfar_cells, _first_valid_sample, _lowest_candidate_level,
-                                     ca_alpha, cfar_mask, os_alpha, training_table, video_power, video_power_table)
+from tdm.frontend.radar_cfar import (VIDEO_LEVELS, _cfar_cells, _first_valid_sample, _lowest_candidate_level, cfar_mask,
+                                     training_table, video_power, video_power_table)
 from tdm.frontend.radar_clutter import _integrate_cells, _margin_over_clutter_db, beam_integrated_power, clutter_map
-from tdm.frontend.radar_config import RadarFrontEndConfig, mount_from_scenario
+from tdm.frontend.radar_config import RadarFrontEndConfig, ca_alpha, mount_from_scenario, os_alpha
 from tdm.frontend.radar_plots import _fill_runs, _label_cells, _spokes_per_label, fill_gaps, label_plots
 
 __all__ = ["RadarFrontEndConfig", "beam_integrated_power", "ca_alpha", "cfar_mask", "clutter_map", "fill_gaps",

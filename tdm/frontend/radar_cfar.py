@@ -1,21 +1,18 @@
 """Radar CFAR along range (module docstring of :mod:`tdm.frontend.radar`, steps 1-2).
 
-Video levels to linear power, the CA and OS thresholds' multipliers, the training-cell windows
-and the CFAR decision of every candidate cell of a sweep.
+Video levels to linear power, the training-cell windows and the CFAR decision of every candidate
+cell of a sweep. The CA and OS multipliers (:func:`ca_alpha`, :func:`os_alpha`) are the
+configuration's (:mod:`tdm.frontend.radar_config`), importable from here too.
 """
 
 from __future__ import annotations
 
-import math
 from functools import lru_cache
-from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
-from scipy.optimize import brentq
 
-if TYPE_CHECKING:
-    from tdm.frontend.radar_config import RadarFrontEndConfig
+from tdm.frontend.radar_config import RadarFrontEndConfig, ca_alpha, os_alpha  # noqa: F401 (names kept here)
 
 __all__ = ["VIDEO_LEVELS", "ca_alpha", "cfar_mask", "os_alpha", "training_table", "video_power", "video_power_table"]
 
@@ -30,34 +27,10 @@ LEVEL_CENTRE_STEPS = 0.5
 #: Power of level 0 (everything below the first level), units of the mean noise: the noise mean
 #: itself, the zero-noise floor (module docstring of :mod:`tdm.frontend.radar`, step 1).
 FLOOR_POWER = 1.0
-#: Bracket of the OS-CFAR multiplier and the solver's tolerances (alpha lies between these for any
-#: N, k and Pfa the configuration allows).
-_OS_ALPHA_BRACKET = (1e-9, 1e12)
-_OS_ALPHA_TOLERANCE = 1e-12
 #: The high bit of one byte: a level plus ``128 - L`` sets it exactly when the level is >= L.
 _BYTE_HIGH_BIT = 128
 #: Bytes (4-bit levels, one a byte) in one 64-bit word.
 _BYTES_PER_WORD = 8
-
-
-def ca_alpha(n_training: int, pfa: float) -> float:
-    """CA-CFAR multiplier ``alpha = N (Pfa^(-1/N) - 1)`` (exponential noise; docs/reference.md section 5)."""
-    return float(n_training * (pfa ** (-1.0 / n_training) - 1.0))
-
-
-@lru_cache(maxsize=64)
-def os_alpha(n_training: int, rank: int, pfa: float) -> float:
-    """OS-CFAR multiplier for the k-th smallest of N training cells (Rohling 1983, exponential noise).
-
-    Solves ``Pfa = prod_{i=0}^{k-1} (N - i) / (N - i + alpha)`` for alpha.
-    """
-    n_i = n_training - np.arange(rank, dtype=float)
-
-    def log_pfa_error(alpha: float) -> float:
-        return float(np.sum(np.log(n_i / (n_i + alpha)))) - math.log(pfa)
-
-    return float(brentq(log_pfa_error, *_OS_ALPHA_BRACKET, xtol=_OS_ALPHA_TOLERANCE,
-                        rtol=_OS_ALPHA_TOLERANCE))
 
 
 @lru_cache(maxsize=8)

@@ -5,12 +5,10 @@
 from __future__ import annotations
 
 from functools import lru_cache
-from typing import TYPE_CHECKING
 
 import numpy as np
 
-if TYPE_CHECKING:
-    from tdm.frontend.radar_config import RadarFrontEndConfig
+from tdm.frontend.radar_config import RadarFrontEndConfig
 
 __all__ = ["beam_integrated_power", "clutter_map"]
 

@@ -5,16 +5,25 @@ Part of the radar front end (:mod:`tdm.frontend.radar`, module docstring for the
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+from functools import lru_cache
 
+import numpy as np
+from scipy.optimize import brentq
+
+from groundfloor.recording import RadarDescription
 from tdm.frames import Mount
-from tdm.frontend.radar_cfar import ca_alpha, os_alpha
 
-__all__ = ["OS_RANK_FRACTION", "RadarFrontEndConfig", "mount_from_scenario"]
+__all__ = ["OS_RANK_FRACTION", "RadarFrontEndConfig", "ca_alpha", "mount_from_scenario", "os_alpha"]
 
 #: Default rank of OS-CFAR as a fraction of the training cells: k about 3N/4 (Rohling 1983;
 #: docs/reference.md section 5).
 OS_RANK_FRACTION = 0.75
+#: Bracket of the OS-CFAR multiplier and the solver's tolerances (alpha lies between these for any
+#: N, k and Pfa the configuration allows).
+_OS_ALPHA_BRACKET = (1e-9, 1e12)
+_OS_ALPHA_TOLERANCE = 1e-12
 
 
 @dataclass(frozen=True)
@@ -180,14 +189,16 @@ class RadarFrontEndConfig:
         ``blanking_m``) and ``own_ship`` (``length_m``, ``beam_m``); absent keys keep the defaults.
         ``overrides`` set any field. The mount is read by :func:`mount_from_scenario`.
         """
-        radar = (scenario.get("sensors") or {}).get("radar") or {}
+        radar = RadarDescription.from_scenario(scenario)
         own = scenario.get("own_ship") or {}
         values: dict = {}
-        for key, field_name, kind in (("range_m", "range_scale_m", float), ("spokes", "spokes", int),
-                                      ("samples", "samples", int), ("beam_az_deg", "beam_az_deg", float),
-                                      ("blanking_m", "blanking_m", float)):
-            if radar.get(key) is not None:
-                values[field_name] = kind(radar[key])
+        for key, field_name in (("range_m", "range_scale_m"), ("spokes", "spokes"), ("samples", "samples"),
+                                ("beam_az_deg", "beam_az_deg")):
+            if getattr(radar, key) is not None:
+                values[field_name] = getattr(radar, key)
+        blanking_m = ((scenario.get("sensors") or {}).get("radar") or {}).get("blanking_m")
+        if blanking_m is not None:  # not part of the recording's description: the radar front end's own
+            values["blanking_m"] = float(blanking_m)
         if own.get("length_m") is not None:
             values["own_ship_length_m"] = float(own["length_m"])
         if own.get("beam_m") is not None:
@@ -197,6 +208,26 @@ class RadarFrontEndConfig:
 
 
 def mount_from_scenario(scenario: dict) -> Mount:
-    """The radar's :class:`~tdm.frames.Mount` from a resolved scenario dict (``sensors.radar.mount``)."""
-    radar = (scenario.get("sensors") or {}).get("radar") or {}
-    return Mount.from_dict(radar.get("mount"))
+    """The radar's :class:`~tdm.frames.Mount` from a resolved scenario dict (``sensors.radar.mount``;
+    :class:`groundfloor.recording.RadarDescription`)."""
+    return RadarDescription.from_scenario(scenario).mount
+
+
+def ca_alpha(n_training: int, pfa: float) -> float:
+    """CA-CFAR multiplier ``alpha = N (Pfa^(-1/N) - 1)`` (exponential noise; docs/reference.md section 5)."""
+    return float(n_training * (pfa ** (-1.0 / n_training) - 1.0))
+
+
+@lru_cache(maxsize=64)
+def os_alpha(n_training: int, rank: int, pfa: float) -> float:
+    """OS-CFAR multiplier for the k-th smallest of N training cells (Rohling 1983, exponential noise).
+
+    Solves ``Pfa = prod_{i=0}^{k-1} (N - i) / (N - i + alpha)`` for alpha.
+    """
+    n_i = n_training - np.arange(rank, dtype=float)
+
+    def log_pfa_error(alpha: float) -> float:
+        return float(np.sum(np.log(n_i / (n_i + alpha)))) - math.log(pfa)
+
+    return float(brentq(log_pfa_error, *_OS_ALPHA_BRACKET, xtol=_OS_ALPHA_TOLERANCE,
+                        rtol=_OS_ALPHA_TOLERANCE))

@@ -1,0 +1,66 @@
+"""What ``tdm run`` can be told: :class:`TdmConfig` (defaults from the recording's scenario.yaml).
+
+Read by the run (:mod:`tdm.pipeline`) and its scan sources (:mod:`tdm.scans`); importable from
+:mod:`tdm.pipeline` too.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from tdm.fusion import FusionConfig
+from tdm.io import read_scenario
+from tdm.tracker import AisTrackerConfig, TrackerConfig
+
+__all__ = ["DEFAULT_UPDATE_RATE_HZ", "FUSION_RULES", "LIDAR_SOURCES", "TdmConfig"]
+
+LIDAR_SOURCES = ("auto", "npz", "pcap")
+FUSION_RULES = ("simple", "ci")
+#: Output rate when scenario.yaml states none, Hz (thesis TDM_update_rate_Hz).
+DEFAULT_UPDATE_RATE_HZ = 1.0
+
+
+@dataclass(frozen=True)
+class TdmConfig:
+    """Everything ``tdm run`` can be told (defaults from the recording's scenario.yaml).
+
+    Attributes
+    ----------
+    update_rate_hz : float
+        Output rate of detected targets (scenario ``tdm.update_rate_hz``; thesis TDM_update_rate_Hz).
+    fusion : str
+        ``simple`` (thesis eq. 3.2) or ``ci`` (covariance intersection).
+    lidar_source : str
+        ``npz`` sweeps, ``pcap``, or ``auto`` (NPZ when present, else the PCAP).
+    workers : int
+        Front-end worker processes (0: in this process).
+    """
+
+    update_rate_hz: float = DEFAULT_UPDATE_RATE_HZ
+    fusion: str = "simple"
+    lidar_source: str = "auto"
+    workers: int = 2
+    lidar_tracker: TrackerConfig = field(default_factory=lambda: TrackerConfig(
+        confirm_m=6, confirm_n=10, coast_s=2.0, position_floor_m2=1.0, max_range_m=100.0))
+    radar_tracker: TrackerConfig = field(default_factory=lambda: TrackerConfig(
+        confirm_m=3, confirm_n=4, coast_s=8.0, position_floor_m2=4.0, max_range_m=1852.0,
+        merge_distance_m=25.0, cross_section_sigma_m2=300.0,
+        # a radar track's second plot is looked for within 4 m/s (8 kn) of standing still, at most
+        # 15 m/s (29 kn): sea-clutter pairs far apart no longer start tracks (busy_open_sea, 300 s:
+        # 4.2 -> 3.2 false targets a minute)
+        init_speed_sigma_mps=4.0, max_speed_mps=15.0,
+        # plots barely over the clutter count half a hit, plots well over it 1.5 (TrackerConfig; busy_open_sea,
+        # 300 s: 3.2 -> 0.8 false targets a minute, and strong new objects confirm a scan sooner)
+        weak_below_db=13.0, strong_from_db=15.0,
+        # a plot narrower than the beam paints is a sea spike, however strong: a weak hit (Detections.beam_fill;
+        # busy_open_sea seeds 7-11, 300 s: 0.6-1.0 -> 0-0.4 false targets a minute)
+        min_beam_fill=0.5))
+    ais_tracker: AisTrackerConfig = field(default_factory=AisTrackerConfig)
+    fusion_config: FusionConfig = field(default_factory=FusionConfig)
+
+    @classmethod
+    def for_recording(cls, recording: Path, **changes) -> "TdmConfig":
+        """The defaults with ``update_rate_hz`` from the recording's scenario.yaml, then ``changes``."""
+        rate = float((read_scenario(recording).get("tdm") or {}).get("update_rate_hz", DEFAULT_UPDATE_RATE_HZ))
+        return cls(**{"update_rate_hz": rate, **changes})
