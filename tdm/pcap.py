@@ -331,48 +331,56 @@ def decode_packets(payloads: np.ndarray, capture_ns: np.ndarray, start_ns: int,
         packets (12 per single-return packet, 6 per dual-return one). ``cycle_step_centideg`` (float):
         the azimuth advance per firing cycle in the last packet, 0.01 deg.
     """
+    packets, capture_ns = _valid_packets(payloads, capture_ns, stats)
+    if packets.shape[0] == 0:
+        return None
+    blocks, dual = packets["blocks"], packets["return_mode"] == RETURN_MODE_DUAL
+    rel_ns = _first_firing_ns(packets["timestamp"].astype(np.int64), capture_ns, dual, stats) - int(start_ns)
+    if clock is not None:
+        timely = clock.keep(rel_ns, stats)
+        if not timely.all():
+            blocks, dual, rel_ns = blocks[timely], dual[timely], rel_ns[timely]
+            if blocks.shape[0] == 0:
+                return None
+    return _points(blocks, dual, rel_ns)
+
+
+def _valid_packets(payloads: np.ndarray, capture_ns: np.ndarray, stats: ReadStats) -> tuple[np.ndarray, np.ndarray]:
+    """The packets (P',) of :data:`PACKET_DTYPE` with good block flags, an HDL-32E product id and a
+    timestamp within the hour, and their capture times (P',) int64 ns; the others counted."""
     packets = payloads.view(PACKET_DTYPE).reshape(-1)
-    blocks = packets["blocks"]
-    valid = np.all(blocks["flag"] == BLOCK_FLAG, axis=1)
+    valid = np.all(packets["blocks"]["flag"] == BLOCK_FLAG, axis=1)
     if (~valid).any():
         stats.count("lidar/pcap: data packet with a bad block flag skipped", int((~valid).sum()))
-    product = packets["product_id"]
-    model_ok = np.isin(product, PRODUCT_IDS_ACCEPTED)
+    model_ok = np.isin(packets["product_id"], PRODUCT_IDS_ACCEPTED)
     other_model = valid & ~model_ok
     if other_model.any():
         stats.count("lidar/pcap: data packet of another Velodyne model skipped (product id)", int(other_model.sum()))
-    stamp_us = packets["timestamp"].astype(np.int64)
-    stamp_ok = stamp_us < 3_600_000_000
+    stamp_ok = packets["timestamp"].astype(np.int64) < 3_600_000_000
     bad_stamp = valid & model_ok & ~stamp_ok
     if bad_stamp.any():
         stats.count("lidar/pcap: data packet with a timestamp past the hour skipped", int(bad_stamp.sum()))
     keep = valid & model_ok & stamp_ok
-    if not keep.all():
-        packets, blocks, stamp_us, capture_ns = packets[keep], blocks[keep], stamp_us[keep], capture_ns[keep]
-    p = packets.shape[0]
-    if p == 0:
-        return None
+    return packets[keep], np.asarray(capture_ns, dtype=np.int64)[keep]
 
-    # time of each packet's first firing: the capture time selects the hour
-    capture_ns = np.asarray(capture_ns, dtype=np.int64)
+
+def _first_firing_ns(stamp_us: np.ndarray, capture_ns: np.ndarray, dual: np.ndarray, stats: ReadStats) -> np.ndarray:
+    """UNIX time (P,) int64 ns of each packet's first firing: its microseconds past the hour, the hour
+    from the capture time; the capture time itself where the two disagree by more than 10 s (counted)."""
     first_ns = (capture_ns // _NS_PER_HOUR) * _NS_PER_HOUR + stamp_us * 1000
     first_ns -= np.where(first_ns - capture_ns > _NS_PER_HOUR // 2, _NS_PER_HOUR, 0)
     first_ns += np.where(capture_ns - first_ns > _NS_PER_HOUR // 2, _NS_PER_HOUR, 0)
-    dual = packets["return_mode"] == RETURN_MODE_DUAL
     unsynced = np.abs(first_ns - capture_ns) > MAX_CLOCK_OFFSET_NS
     if unsynced.any():
         stats.count("lidar/pcap: packet clock off the capture time by > 10 s (capture time used)", int(unsynced.sum()))
         cycles = np.where(dual, BLOCKS_PER_PACKET // 2, BLOCKS_PER_PACKET)
         first_ns = np.where(unsynced, capture_ns - cycles * CYCLE_DT_NS, first_ns)
-    rel_ns = first_ns - int(start_ns)
-    if clock is not None:
-        timely = clock.keep(rel_ns, stats)
-        if not timely.all():
-            blocks, dual, rel_ns = blocks[timely], dual[timely], rel_ns[timely]
-            p = blocks.shape[0]
-            if p == 0:
-                return None
+    return first_ns
 
+
+def _points(blocks: np.ndarray, dual: np.ndarray, rel_ns: np.ndarray) -> dict[str, np.ndarray]:
+    """The firing cycles and points of packets' blocks (P, 12), as :func:`decode_packets` returns them."""
+    p = blocks.shape[0]
     # firing cycles: one per block (single return) or per pair of blocks (dual)
     block_az = blocks["azimuth"]
     firing_az = firing_azimuths_centideg(block_az, dual)
@@ -462,15 +470,46 @@ def iter_pcap_sweeps(path: Path, start_time_unix_s: float, stats: ReadStats,
     """
     path = Path(path)
     start_ns = int(round(float(start_time_unix_s) * 1e6)) * 1000
+    clock = PacketClock(window_s) if window_s is not None else None
+    pending: list[dict[str, np.ndarray]] = []  # pieces of the revolution in progress
+    last_az: int | None = None  # azimuth of the last firing cycle seen
+    step = 0.0  # azimuth step per cycle of the last packet, 0.01 deg
+    for captures, payloads in _packet_chunks(path, stats, chunk_bytes):
+        decoded = decode_packets(payloads, captures, start_ns, stats, clock)
+        if decoded is None:
+            continue
+        step = decoded["cycle_step_centideg"]
+        az = decoded["cycle_az"]
+        previous = np.concatenate([[az[0] if last_az is None else last_az], az[:-1]])
+        wraps = np.flatnonzero(az - previous < -CENTIDEG_PER_TURN // 2)  # first cycles of new revolutions
+        last_az = int(az[-1])
+        cuts = np.searchsorted(decoded["point_cycle"], wraps)
+        bounds = np.concatenate([[0], cuts, [decoded["point_cycle"].shape[0]]])
+        for i in range(bounds.shape[0] - 1):
+            if i > 0:  # a wrap closes the revolution in progress
+                if pending:
+                    yield _concat(pending)
+                pending = []
+            pending.append({k: decoded[k][bounds[i]: bounds[i + 1]] for k in SWEEP_FIELDS})
+    if pending and last_az is not None and last_az + step >= CENTIDEG_PER_TURN:
+        yield _concat(pending)
+
+
+def _packet_chunks(path: Path, stats: ReadStats, chunk_bytes: int) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+    """The file's HDL-32E data packets, ``chunk_bytes`` of file at a time.
+
+    Yields
+    ------
+    captures : (P,) int64
+        UNIX capture time of each packet, ns.
+    payloads : (P, 1206) uint8
+        Their UDP payloads.
+    """
     regular_file(path)
     with open(path, "rb") as handle:
         fmt = _read_global_header(path, handle.read(GLOBAL_HEADER_BYTES))
         carry = np.zeros(0, dtype=np.uint8)
-        clock = PacketClock(window_s) if window_s is not None else None
         state: dict = {}
-        pending: list[dict[str, np.ndarray]] = []  # pieces of the revolution in progress
-        last_az: int | None = None  # azimuth of the last firing cycle seen
-        step = 0.0  # azimuth step per cycle of the last packet, 0.01 deg
         final = False
         while not final:
             data = handle.read(chunk_bytes)
@@ -478,9 +517,7 @@ def iter_pcap_sweeps(path: Path, start_time_unix_s: float, stats: ReadStats,
             buf = np.concatenate([carry, np.frombuffer(data, dtype=np.uint8)]) if carry.size else \
                 np.frombuffer(data, dtype=np.uint8)
             runs, consumed = _walk_records(buf, fmt, stats, final, state)
-            carry = buf[consumed:].copy()
-            if final and carry.size:
-                carry = carry[:0]
+            carry = buf[consumed:].copy() if not final else buf[:0]
             captures, payloads = [], []
             for offset, count, length in runs:
                 records = buf[offset: offset + count * (RECORD_HEADER_BYTES + length)].reshape(count, -1)
@@ -488,24 +525,5 @@ def iter_pcap_sweeps(path: Path, start_time_unix_s: float, stats: ReadStats,
                 if c.size:
                     captures.append(c)
                     payloads.append(pl)
-            if not payloads:
-                continue
-            decoded = decode_packets(np.concatenate(payloads), np.concatenate(captures), start_ns, stats, clock)
-            if decoded is None:
-                continue
-            step = decoded["cycle_step_centideg"]
-            az = decoded["cycle_az"]
-            previous = np.concatenate([[az[0] if last_az is None else last_az], az[:-1]])
-            wraps = np.flatnonzero(az - previous < -CENTIDEG_PER_TURN // 2)  # first cycles of new revolutions
-            last_az = int(az[-1])
-            cuts = np.searchsorted(decoded["point_cycle"], wraps)
-            bounds = np.concatenate([[0], cuts, [decoded["point_cycle"].shape[0]]])
-            for i in range(bounds.shape[0] - 1):
-                if i > 0:  # a wrap closes the revolution in progress
-                    if pending:
-                        yield _concat(pending)
-                    pending = []
-                piece = {k: decoded[k][bounds[i]: bounds[i + 1]] for k in SWEEP_FIELDS}
-                pending.append(piece)
-        if pending and last_az is not None and last_az + step >= CENTIDEG_PER_TURN:
-            yield _concat(pending)
+            if payloads:
+                yield np.concatenate(captures), np.concatenate(payloads)
