@@ -406,6 +406,79 @@ COLUMNS = (("ours", "radar", "ours radar"), ("ours", "lidar", "ours LiDAR"),
            ("stonesoup", "central_ais", "Stone Soup central (LiDAR+radar+AIS positions)"))
 
 
+def _metrics_of(res: dict, side: str, name: str, chosen: dict) -> dict:
+    """The metrics of one column: ours by sensor, or Stone Soup's tracker at its chosen q."""
+    return res["ours"].get(name, {}) if side == "ours" else res["stonesoup"][chosen[name]][name]
+
+
+def _intro(results: dict, chosen: dict, q_values: tuple, floor: bool, quick: bool, version: str) -> list[str]:
+    """The report's opening paragraphs: recordings, metric, both trackers' set-ups and the chosen q."""
+    first = next(iter(results.values()))
+    settings = first["settings"]
+    return [
+        machine_line("stonesoup_compare", quick) + f" Stone Soup {version}.",
+        "",
+        "Recordings: " + "; ".join(f"`scenarios/{s}.yaml` rendered with `raysim render --duration {r['duration_s']:g}` "
+                                   f"(seed of the scenario; {r['detections'].get('lidar', 0)} LiDAR and "
+                                   f"{r['detections'].get('radar', 0)} radar detections, {r['detections'].get('ais', 0)} "
+                                   "AIS reports)" for s, r in results.items()) + ".",
+        "",
+        "Same detections (the front ends of `tdm run`, read through `tdm.pipeline.DetectionStream`), same metric "
+        f"code (`tdm.evaluate.evaluate`: GOSPA/OSPA cut-off c = {DEFAULT_CUTOFF_M:g} m, p = {DEFAULT_ORDER_P:g}, "
+        f"alpha = {GOSPA_ALPHA:g}, means over epochs every "
+        f"{1 / first['rate_hz']:g} s). Per-sensor figures are scored against the objects in that sensor's range; "
+        "fused and central ones against the objects in range of any sensor (AIS included, so the LiDAR+radar "
+        "central tracker cannot see AIS-only targets). Lower is better.",
+        "",
+        "Stone Soup: `MultiTargetTracker`; `ExtendedKalmanPredictor` on "
+        "`CombinedLinearGaussianTransitionModel([ConstantVelocity(q), ConstantVelocity(q)])`; `ExtendedKalmanUpdater` "
+        "with each detection's own `LinearGaussian` (covariance = its `position_cov_m2`"
+        f"{' + our floor' if floor else ''}; AIS {settings['ais']['floor_m2']:g} m^2 per axis, our AIS "
+        "tracker's); `DistanceHypothesiser` (`Mahalanobis`, missed distance = our gate); `GNNWith2DAssignment`; "
+        "`MultiMeasurementInitiator` (prior velocity sigma = our new tracks' speed sigma); `UpdateTimeDeleter`. Scans fed "
+        "as (scan end time, detections at their own times); tracks predicted to each output epoch. From our "
+        "configuration: " + "; ".join(
+            f"{k}: min_points {v['min_points']}, holding track dropped after {v['hold_misses'] + 1} scans without "
+            f"update (`UpdateTimeStepsDeleter`), coast {v['coast_s']:g} s, missed distance {v['missed_distance']:.2f}, "
+            f"prior velocity sigma {v['prior_speed_sigma_mps']:g} m/s, floor {v['floor_m2']:g} m^2"
+            for k, v in settings.items() if k != "ais")
+        + "; central: radar's, holding time (hold + 1) radar revolutions. "
+        f"q swept over {', '.join(f'{q:g}' for q in q_values)} m^2/s^3 and chosen per tracker by the lowest GOSPA "
+        "averaged over the recordings: " + ", ".join(f"{k} q = {v:g}" for k, v in chosen.items()) + ".",
+        "",
+        ("Ours: `tdm run` defaults (`TdmConfig`): thesis EKF (course, speed, turn rate, cross-section), GNN, M of N, "
+         "merge and speed checks per sensor; fused: thesis eq. 3.2 over the LiDAR, radar and AIS tracks."),
+    ]
+
+
+def _notes(results: dict, chosen: dict, q_values: tuple) -> list[str]:
+    """Per-scenario tables, the Stone Soup q sweep and the wall times."""
+    notes = []
+    for scenario, res in results.items():
+        notes += [f"## {scenario}, {res['duration_s']:g} s", "",
+                  "| metric | " + " | ".join(label for _, _, label in COLUMNS) + " |",
+                  "|---|" + "---:|" * len(COLUMNS)]
+        for label, key, digits in TABLE_METRICS:
+            notes.append(f"| {label} | " + " | ".join(_fmt(_metrics_of(res, side, name, chosen).get(key), digits)
+                                                     for side, name, _ in COLUMNS) + " |")
+        notes.append("")
+    if any(_metrics_of(res, side, name, chosen).get("gospa_m") is None for res in results.values() for side, name, _ in COLUMNS):
+        notes += ["\"-\": not scored (`tdm.evaluate` scores a sensor only when it output tracks).", ""]
+    notes += ["## Stone Soup q sweep (GOSPA, m)", "",
+              "| recording | q, m^2/s^3 | " + " | ".join(STONESOUP_TRACKERS) + " |",
+              "|---|---:|" + "---:|" * len(STONESOUP_TRACKERS)]
+    for scenario, res in results.items():
+        for q in q_values:
+            notes.append(f"| {scenario} | {q:g} | " + " | ".join(
+                _fmt(res["stonesoup"][q][n].get("gospa_m"), 2) for n in STONESOUP_TRACKERS) + " |")
+    notes += ["", "Wall time, s: ours = whole `tdm run` (front ends in 2 worker processes, trackers, fusion, "
+              "writing); Stone Soup = tracking alone at the chosen q (front ends excluded). " + "; ".join(
+                  f"{s}: ours {r['ours_wall_s']:.1f}, " + ", ".join(
+                      f"{n} {r['stonesoup_wall_s'][chosen[n]][n]:.1f}" for n in STONESOUP_TRACKERS)
+                  for s, r in results.items()) + ".", ""]
+    return notes
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--quick", action="store_true", help="30 s recordings, two q values")
@@ -431,71 +504,10 @@ def main(argv=None) -> int:
     import stonesoup
 
     chosen = {name: best_q(results, name) for name in STONESOUP_TRACKERS}
-
-    def metrics_of(res, side, name):
-        return res["ours"].get(name, {}) if side == "ours" else res["stonesoup"][chosen[name]][name]
-
-    rows = [(f"{scenario}: GOSPA, m, {label}", _fmt(metrics_of(res, side, name).get("gospa_m"), 2))
+    rows = [(f"{scenario}: GOSPA, m, {label}", _fmt(_metrics_of(res, side, name, chosen).get("gospa_m"), 2))
             for scenario, res in results.items() for side, name, label in COLUMNS]
-    first = next(iter(results.values()))
-    settings = first["settings"]
-    intro = [
-        machine_line("stonesoup_compare", args.quick) + f" Stone Soup {stonesoup.__version__}.",
-        "",
-        "Recordings: " + "; ".join(f"`scenarios/{s}.yaml` rendered with `raysim render --duration {r['duration_s']:g}` "
-                                   f"(seed of the scenario; {r['detections'].get('lidar', 0)} LiDAR and "
-                                   f"{r['detections'].get('radar', 0)} radar detections, {r['detections'].get('ais', 0)} "
-                                   "AIS reports)" for s, r in results.items()) + ".",
-        "",
-        "Same detections (the front ends of `tdm run`, read through `tdm.pipeline.DetectionStream`), same metric "
-        f"code (`tdm.evaluate.evaluate`: GOSPA/OSPA cut-off c = {DEFAULT_CUTOFF_M:g} m, p = {DEFAULT_ORDER_P:g}, "
-        f"alpha = {GOSPA_ALPHA:g}, means over epochs every "
-        f"{1 / first['rate_hz']:g} s). Per-sensor figures are scored against the objects in that sensor's range; "
-        "fused and central ones against the objects in range of any sensor (AIS included, so the LiDAR+radar "
-        "central tracker cannot see AIS-only targets). Lower is better.",
-        "",
-        "Stone Soup: `MultiTargetTracker`; `ExtendedKalmanPredictor` on "
-        "`CombinedLinearGaussianTransitionModel([ConstantVelocity(q), ConstantVelocity(q)])`; `ExtendedKalmanUpdater` "
-        "with each detection's own `LinearGaussian` (covariance = its `position_cov_m2`"
-        f"{' + our floor' if args.floor else ''}; AIS {settings['ais']['floor_m2']:g} m^2 per axis, our AIS "
-        "tracker's); `DistanceHypothesiser` (`Mahalanobis`, missed distance = our gate); `GNNWith2DAssignment`; "
-        "`MultiMeasurementInitiator` (prior velocity sigma = our new tracks' speed sigma); `UpdateTimeDeleter`. Scans fed "
-        "as (scan end time, detections at their own times); tracks predicted to each output epoch. From our "
-        "configuration: " + "; ".join(
-            f"{k}: min_points {v['min_points']}, holding track dropped after {v['hold_misses'] + 1} scans without "
-            f"update (`UpdateTimeStepsDeleter`), coast {v['coast_s']:g} s, missed distance {v['missed_distance']:.2f}, "
-            f"prior velocity sigma {v['prior_speed_sigma_mps']:g} m/s, floor {v['floor_m2']:g} m^2"
-            for k, v in settings.items() if k != "ais")
-        + "; central: radar's, holding time (hold + 1) radar revolutions. "
-        f"q swept over {', '.join(f'{q:g}' for q in q_values)} m^2/s^3 and chosen per tracker by the lowest GOSPA "
-        "averaged over the recordings: " + ", ".join(f"{k} q = {v:g}" for k, v in chosen.items()) + ".",
-        "",
-        ("Ours: `tdm run` defaults (`TdmConfig`): thesis EKF (course, speed, turn rate, cross-section), GNN, M of N, "
-         "merge and speed checks per sensor; fused: thesis eq. 3.2 over the LiDAR, radar and AIS tracks."),
-    ]
-    notes = []
-    for scenario, res in results.items():
-        notes += [f"## {scenario}, {res['duration_s']:g} s", "",
-                  "| metric | " + " | ".join(label for _, _, label in COLUMNS) + " |",
-                  "|---|" + "---:|" * len(COLUMNS)]
-        for label, key, digits in TABLE_METRICS:
-            notes.append(f"| {label} | " + " | ".join(_fmt(metrics_of(res, side, name).get(key), digits)
-                                                     for side, name, _ in COLUMNS) + " |")
-        notes.append("")
-    if any(metrics_of(res, side, name).get("gospa_m") is None for res in results.values() for side, name, _ in COLUMNS):
-        notes += ["\"-\": not scored (`tdm.evaluate` scores a sensor only when it output tracks).", ""]
-    notes += ["## Stone Soup q sweep (GOSPA, m)", "",
-              "| recording | q, m^2/s^3 | " + " | ".join(STONESOUP_TRACKERS) + " |",
-              "|---|---:|" + "---:|" * len(STONESOUP_TRACKERS)]
-    for scenario, res in results.items():
-        for q in q_values:
-            notes.append(f"| {scenario} | {q:g} | " + " | ".join(
-                _fmt(res["stonesoup"][q][n].get("gospa_m"), 2) for n in STONESOUP_TRACKERS) + " |")
-    notes += ["", "Wall time, s: ours = whole `tdm run` (front ends in 2 worker processes, trackers, fusion, "
-              "writing); Stone Soup = tracking alone at the chosen q (front ends excluded). " + "; ".join(
-                  f"{s}: ours {r['ours_wall_s']:.1f}, " + ", ".join(
-                      f"{n} {r['stonesoup_wall_s'][chosen[n]][n]:.1f}" for n in STONESOUP_TRACKERS)
-                  for s, r in results.items()) + ".", ""]
+    intro = _intro(results, chosen, q_values, args.floor, args.quick, stonesoup.__version__)
+    notes = _notes(results, chosen, q_values)
     figures = {s: {"ours": r["ours"], "stonesoup_chosen": {n: r["stonesoup"][chosen[n]][n] for n in STONESOUP_TRACKERS},
                    "stonesoup_sweep": {str(q): v for q, v in r["stonesoup"].items()}, "detections": r["detections"],
                    "duration_s": r["duration_s"]} for s, r in results.items()}

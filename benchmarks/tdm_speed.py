@@ -159,20 +159,8 @@ def peak_memory(recording: Path, workers: int) -> tuple[float, float]:
     return own, children
 
 
-def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--quick", action="store_true", help="60 s recording, one run each")
-    parser.add_argument("--fresh", action="store_true", help="render again even if a matching render exists")
-    parser.add_argument("--recording", type=Path, help="where to render (default /tmp/tdm_bench_bos[_quick])")
-    parser.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results" / "tdm_speed.md")
-    parser.add_argument("--json", type=Path, help="also write the figures as JSON")
-    args = parser.parse_args(argv)
-    duration = 60.0 if args.quick else 300.0
-    reps = 1 if args.quick else 3
-    rec_dir = args.recording or Path("/tmp/tdm_bench_bos" + ("_quick" if args.quick else ""))
-    rec, render_s = ensure_recording(SCENARIO, rec_dir, duration, args.fresh)
-    manifest = read_manifest(rec)
-
+def _measure(rec: Path, reps: int, duration: float) -> dict:
+    """Every measurement of the benchmark on the recording ``rec`` (wall and CPU times, stages, memory)."""
     load_before = os.getloadavg()[0]
     walls, cpus = {}, {}
     for workers in (2, 0):
@@ -196,6 +184,19 @@ def main(argv=None) -> int:
     # the row "first detection reaches the trackers" shows which the pipeline does.
     idle_now = duration / (work2 / 2.0 + main2)
     idle_overlap = duration / max(main2, (main2 + work2) / 2.0)
+    return dict(load_before=load_before, load_after=load_after, walls=walls, cpus=cpus, result=result,
+                built0=built0, stream0=stream0, stream2=stream2, n_events=n_events, first2=first2, last2=last2,
+                scans=scans, memory=memory, med=med, best=best, rtf=rtf, tracking=tracking, main2=main2,
+                work2=work2, cpu0=cpu0, idle_now=idle_now, idle_overlap=idle_overlap)
+
+
+def _report(m: dict, manifest: dict, duration: float, reps: int, render_s, quick: bool):
+    """(rows, intro, notes, figures) of the report from :func:`_measure`'s figures."""
+    load_before, load_after, walls, cpus, result = m["load_before"], m["load_after"], m["walls"], m["cpus"], m["result"]
+    built0, stream0, stream2, n_events = m["built0"], m["stream0"], m["stream2"], m["n_events"]
+    first2, last2, scans, memory, med, best, rtf = m["first2"], m["last2"], m["scans"], m["memory"], m["med"], m["best"], m["rtf"]
+    tracking, main2, work2, cpu0 = m["tracking"], m["main2"], m["work2"], m["cpu0"]
+    idle_now, idle_overlap = m["idle_now"], m["idle_overlap"]
     counts = manifest.get("counts", {})
     rows = [
         ("scenario seconds", f"{duration:g}"),
@@ -232,7 +233,7 @@ def main(argv=None) -> int:
         ("peak memory, no workers, MB", f"{memory[0][0]:.0f}"),
     ]
     intro = [
-        machine_line("tdm_speed", args.quick), "",
+        machine_line("tdm_speed", quick), "",
         f"`run_tdm` (the `tdm run` command's work: read, detect, track, fuse, write detected_targets.jsonl and "
         f"sensor_tracks.jsonl) on a {duration:g} s render of `scenarios/busy_open_sea.yaml` "
         f"({'reused' if render_s is None else f'rendered in {render_s:.0f} s'}, LiDAR from the NPZ sweeps), "
@@ -255,6 +256,25 @@ def main(argv=None) -> int:
                "events": n_events, "duration_s": duration, "cpu_s_workers2": cpus[2], "cpu_s_workers0": cpus[0],
                "first_event_s_workers2": first2, "idle_estimate_not_overlapped": idle_now, "idle_estimate_overlapped": idle_overlap,
                "load_average": [load_before, load_after]}
+    return rows, intro, notes, figures
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--quick", action="store_true", help="60 s recording, one run each")
+    parser.add_argument("--fresh", action="store_true", help="render again even if a matching render exists")
+    parser.add_argument("--recording", type=Path, help="where to render (default /tmp/tdm_bench_bos[_quick])")
+    parser.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results" / "tdm_speed.md")
+    parser.add_argument("--json", type=Path, help="also write the figures as JSON")
+    args = parser.parse_args(argv)
+    duration = 60.0 if args.quick else 300.0
+    reps = 1 if args.quick else 3
+    rec_dir = args.recording or Path("/tmp/tdm_bench_bos" + ("_quick" if args.quick else ""))
+    rec, render_s = ensure_recording(SCENARIO, rec_dir, duration, args.fresh)
+    manifest = read_manifest(rec)
+
+    m = _measure(rec, reps, duration)
+    rows, intro, notes, figures = _report(m, manifest, duration, reps, render_s, args.quick)
     publish("TDM speed benchmark", intro, rows, args.out, args.json, figures, notes)
     return 0
 
