@@ -138,6 +138,19 @@ def build_parser() -> argparse.ArgumentParser:
     bench = sub.add_parser("bench", help="run the benchmarks and print their tables")
     bench.add_argument("--quick", action="store_true", help="fewer rays and repetitions")
     bench.add_argument("--json", type=Path, help="also write the results as JSON")
+
+    rcs = sub.add_parser("rcs", help="radar cross-section of a mesh by shooting and bouncing rays (docs/radar.md)")
+    rcs.add_argument("mesh", type=Path, help="mesh file (.obj/.stl/.ply/.glb), body frame, m")
+    rcs.add_argument("--material", default="steel", help="steel (perfect conductor) or a raysim material name")
+    rcs.add_argument("--range-m", type=float, default=1000.0, help="range, m (far field: reported only)")
+    rcs.add_argument("--aspects", type=_count("--aspects"), default=360, help="aspects over 360 deg")
+    rcs.add_argument("--elevation-deg", type=float, default=0.0, help="radar elevation above the xy plane, deg")
+    rcs.add_argument("--frequency-ghz", type=float, default=9.41, help="radar frequency, GHz")
+    rcs.add_argument("--polarisation", default="HH", help="HH, VV, HV or VH")
+    rcs.add_argument("--sea", action="store_true", help="flat perfectly conducting sea at z = 0")
+    rcs.add_argument("--bounces", type=_count("--bounces"), default=3, help="maximum bounces per ray")
+    rcs.add_argument("--ray-spacing-m", type=float, help="ray-tube side, m (default lambda/4, coarser for big meshes)")
+    rcs.add_argument("--json", type=Path, help="also write the results as JSON")
     return parser
 
 
@@ -291,6 +304,13 @@ def cmd_import_hilsim(args) -> int:
 BENCHMARKS = ("ray_engine", "lidar", "radar", "rosbag", "tdm_speed", "tdm_criteria", "batch_throughput")
 
 
+def cmd_rcs(args) -> int:
+    """Radar cross-section of a mesh over a turn of aspects (:mod:`raysim.rcs`)."""
+    from raysim.rcs.command import run
+
+    return run(args)
+
+
 def cmd_bench(args) -> int:
     """Run the benchmarks and print their tables (the committed results files are left untouched).
 
@@ -327,7 +347,7 @@ def cmd_bench(args) -> int:
 
 
 COMMANDS = {"render": cmd_render, "run": cmd_run, "batch": cmd_batch, "import-hilsim": cmd_import_hilsim,
-            "bench": cmd_bench}
+            "bench": cmd_bench, "rcs": cmd_rcs}
 
 
 def main(argv: list[str] | None = None) -> int:
