@@ -80,6 +80,8 @@ def run(args) -> int:
     print(f"{args.mesh}: {args.aspects} aspects, elevation {args.elevation_deg:g} deg, "
           f"{args.frequency_ghz:g} GHz {args.polarisation}, {args.material}, {'over the sea' if args.sea else 'free space'}")
     print(f"far field (plane wave); range {args.range_m:g} m, far-field distance 2 D^2 / lambda = {far:.0f} m")
+    if args.sea:
+        print("sea: a flat, perfectly conducting plane (an upper bound: no Fresnel loss, no roughness; docs/radar.md)")
     for key in ("median", "min", "max"):
         value = result[f"{key}_m2"]
         print(f"{key:>6}: {value:.4g} m^2  {_db(value)}")
