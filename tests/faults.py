@@ -89,3 +89,15 @@ def small_disk(path: Path, size_bytes: int, kind: str = "tmpfs") -> Iterator[Dis
 def left_in(path: Path) -> list[str]:
     """Every entry under ``path`` (hidden ones too) but the filler, relative, sorted."""
     return sorted(str(p.relative_to(path)) for p in path.rglob("*") if p.name != "filler")
+
+
+def dead_pid() -> int:
+    """The PID of a process that has ended and been reaped."""
+    for _ in range(10):
+        child = subprocess.Popen([sys.executable, "-c", "pass"])
+        child.wait()
+        try:
+            os.kill(child.pid, 0)
+        except ProcessLookupError:
+            return child.pid
+    raise AssertionError("no dead PID found")

@@ -20,7 +20,7 @@ import yaml
 
 from raysim.cli import main
 from tests.conftest import REPO
-from tests.faults import left_in, small_disk
+from tests.faults import dead_pid, left_in, small_disk
 
 BUSY = REPO / "scenarios" / "busy_open_sea.yaml"
 
@@ -98,18 +98,6 @@ def test_sigterm_removes_the_staging_directory_and_exits_143(tmp_path):
     assert proc.returncode == 143, stderr
     assert stderr.splitlines() == ["error: terminated; nothing was written"] and stdout == ""
     assert sorted(p.name for p in tmp_path.iterdir()) == []
-
-
-def dead_pid() -> int:
-    """The PID of a process that has ended and been reaped."""
-    for _ in range(10):
-        child = subprocess.Popen([sys.executable, "-c", "pass"])
-        child.wait()
-        try:
-            os.kill(child.pid, 0)
-        except ProcessLookupError:
-            return child.pid
-    raise AssertionError("no dead PID found")
 
 
 def test_the_next_run_removes_staging_directories_of_dead_processes_only(tmp_path, capsys):

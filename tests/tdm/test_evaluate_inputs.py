@@ -21,7 +21,7 @@ from tdm.cli import main
 from tdm.errors import RecordingError
 from tdm.eval_params import read_params
 from tdm.eval_truth import epoch_grid, read_truth_enu, truth_at
-from tests.tdm.test_evaluate import make_recording, save_sweep
+from tests.tdm.eval_helpers import make_recording, save_sweep
 
 
 @pytest.fixture(scope="module")

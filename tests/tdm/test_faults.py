@@ -13,8 +13,7 @@ import signal
 import pytest
 
 from tdm.cli import main
-from tests.faults import left_in, small_disk
-from tests.raysim.test_faults import dead_pid
+from tests.faults import dead_pid, left_in, small_disk
 from tests.tdm.conftest import REPO, render_recording
 
 
