@@ -26,7 +26,7 @@ import numpy as np
 from tdm.errors import RecordingError
 from tdm.eval_params import EvalParams
 from tdm.eval_truth import TruthAtEpochs
-from tdm.recording.npz import ArrayHeader, Unreadable, load_arrays, read_layout
+from tdm.recording.npz import ArrayHeader, NpzFile, Unreadable
 from tdm.recording.sweeps import unreadable_warning
 
 #: Half-width of the window about an epoch in which a LiDAR hit, or the radar's view of an object, makes it
@@ -70,11 +70,11 @@ def load_sweep(file: Path, spec: dict[str, tuple[str, int]], sensor: str, warnin
         An array not as ``spec`` says, or beyond what its file holds (module docstring).
     """
     try:
-        layout = read_layout(file)
-        if not all(name in layout for name in spec):
-            return NO_RAY_TRUTH
-        _check_spec(file, layout, spec)
-        return load_arrays(file, tuple(spec))
+        with NpzFile(file) as npz:  # one pass over the archive: headers checked, then the arrays read
+            if not all(name in npz.layout for name in spec):
+                return NO_RAY_TRUTH
+            _check_spec(file, npz.layout, spec)
+            return npz.load(tuple(spec))
     except Unreadable as exc:
         _count(warnings, f"{unreadable_warning(sensor, exc.reason)}, counted as not seen")
         return None
