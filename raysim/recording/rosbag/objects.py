@@ -102,21 +102,6 @@ def target_box_m(descriptor: str, footprint_m2: float) -> tuple[float, float, fl
     return max(length, 1.0), max(width, 1.0), max(width / 2.0, 1.0)
 
 
-def _epochs(path: Path) -> Iterator[tuple[float, list[dict]]]:
-    """(t, rows) of a JSON-lines file whose lines come in groups of equal ``t``."""
-    t_cur, rows = None, []
-    with open(path, encoding="utf-8") as handle:
-        for line in handle:
-            row = json.loads(line)
-            if rows and row["t"] != t_cur:
-                yield t_cur, rows
-                rows = []
-            t_cur = row["t"]
-            rows.append(row)
-    if rows:
-        yield t_cur, rows
-
-
 def _label(r: dict) -> str:
     return f"T{r['target_id']} {r['object_descriptor']} {r['sog_mps'] * KNOTS_PER_MPS:.1f} kn"
 
@@ -153,7 +138,7 @@ def target_streams(recording: Path, frame, ns_of: NsOf, period_s: float) -> Iter
     path = recording / "tdm" / "detected_targets.jsonl"
     if not path.is_file():
         return
-    for t_s, rows in _epochs(path):
+    for t_s, rows in truth_epochs(path, lambda t_s: True):  # any JSON-lines file grouped by its leading "t"
         t_ns = ns_of(t_s)
         yield BagMessage(t_ns, "/tdm/detected_targets", "tdm_msgs/msg/DetectedTargetArray",
                          make("tdm_msgs/msg/DetectedTargetArray", header=header(t_ns, "map"),
