@@ -34,7 +34,7 @@ def key_figures(res: dict) -> dict[str, float]:
         out["own ship: ns/ray without it"] = ow["ns_per_ray_without"]
         out["own ship: ns/ray with it, plain cast"] = ow["ns_per_ray_with"]
         if "ns_per_ray_with_carrier" in ow:
-            out["own ship: ns/ray with it, carrier="] = ow["ns_per_ray_with_carrier"]
+            out["own ship: ns/ray with it, CarrierScene"] = ow["ns_per_ray_with_carrier"]
     return out
 
 

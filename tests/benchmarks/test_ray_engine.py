@@ -42,7 +42,7 @@ def test_benchmark_report_and_main(tmp_path, monkeypatch, capsys):
                      "ns_per_ray_with": 200.0, "ns_per_ray_with_carrier": 40.0},
     }
     figures = benchmarking.key_figures(res)
-    assert figures["own ship: ns/ray with it, carrier="] == 40.0 and len(figures) == 4
+    assert figures["own ship: ns/ray with it, CarrierScene"] == 40.0 and len(figures) == 4
     text = benchmarking.to_markdown(dict(res, runs=[figures, figures]))
     assert "| 2 | " in text and "| with own ship, `CarrierScene.cast(...)`" in text
     assert "| figure | run 1 | run 2 | median |" in text and "| 40.00 | 40.00 | 40.00 |" in text
