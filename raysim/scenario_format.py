@@ -57,11 +57,25 @@ class Origin:
 
 
 @dataclass(frozen=True, kw_only=True)
+class RainCell:
+    """A convective rain cell: an EXCELL exponential profile ``R(r) = rate_mm_per_h exp(-r / radius_m)``
+    (Capsoni et al. 1987), drifting with the wind (docs/radar.md section 4)."""
+
+    position: LatLon = param(doc="Centre [lat, lon] of the cell at t = 0, deg", check=_lat_lon_check)
+    radius_m: float = param(2000.0, doc="EXCELL 1/e radius r0 of the rate profile, m", gt=0, le=50_000, check=SIZE_CHECK)
+    rate_mm_per_h: float = param(20.0, doc="Peak rain rate at the centre (added to rain_mm_per_h), mm/h", gt=0, le=300)
+
+
+@dataclass(frozen=True, kw_only=True)
 class Environment:
     sea_state: int = param(2, doc="Douglas sea state 0..6: sea clutter, foam, waves, own-ship motion", ge=0, le=6)
     wind_speed_mps: float = param(5.0, doc="True wind speed, m/s", ge=0, le=70)
     wind_from_deg: float = param(0.0, doc="Direction the wind blows from, compass deg", ge=0, lt=360)
-    rain_mm_per_h: float = param(0.0, doc="Rain rate, mm/h (radar attenuation and clutter, LiDAR attenuation)", ge=0, le=300)
+    rain_mm_per_h: float = param(0.0, doc="Uniform (stratiform) background rain rate everywhere, mm/h (radar attenuation and "
+                                 "clutter, LiDAR attenuation)", ge=0, le=300)
+    rain_cells: tuple[RainCell, ...] = param(
+        (), doc="Convective rain cells (radar): EXCELL exponential profiles added to rain_mm_per_h, drifting with "
+        "the wind at wind_speed_mps towards wind_from_deg + 180")
     fog_visibility_m: float | None = param(None, doc="Meteorological visibility in fog, m; null = no fog", gt=0, check=SIZE_CHECK)
 
 
@@ -128,6 +142,21 @@ class Lidar:
 
 
 @dataclass(frozen=True, kw_only=True)
+class Interferer:
+    """Another radar nearby whose pulses our receiver picks up (docs/radar.md, "Interference")."""
+
+    position: LatLon = param(doc="Position [lat, lon] of the other radar, deg", check=_lat_lon_check)
+    prf_hz: float = param(1000.0, doc="Its pulse repetition frequency, Hz (marine sets: about 400..4000)", ge=100, le=10_000)
+    rpm: float = param(24.0, doc="Its antenna rotation, revolutions per minute", gt=0, le=120)
+    level_db: float = param(
+        60.0, doc="Received level of its pulses over our noise when both main beams point at each other, dB",
+        ge=0, le=150)
+    beam_az_deg: float = param(1.9, doc="Its horizontal -3 dB beam width, deg (a 4 ft open array: 1.9)", gt=0, le=45)
+    pulse_length_us: float = param(0.08, doc="Its pulse length, us (short-range pulses: 0.05..0.1)", gt=0, le=50)
+    azimuth0_deg: float = param(0.0, doc="Its antenna azimuth at t = 0, compass deg", ge=0, lt=360)
+
+
+@dataclass(frozen=True, kw_only=True)
 class Radar:
     enabled: bool = param(True, doc="Render this sensor")
     model: Literal["broadband-4g", "broadband-3g"] = param("broadband-4g", doc="Radar model (Simrad/Navico Broadband class)")
@@ -152,6 +181,11 @@ class Radar:
     resolve_m: float = param(
         6.0, doc="Ray spacing across the beam at the range scale (or the horizon if nearer), m", gt=0, le=100,
         check=RESOLVE_CHECK)
+    interference: tuple[Interferer, ...] = param(
+        (), doc="Other radars whose pulses show as dotted spiral arcs; empty = no interference")
+    interference_rejection: Literal["off", "low", "medium", "high"] = param(
+        "off", doc="Interference rejection (sweep-to-sweep correlation of the video): off, low (echo on either "
+        "neighbouring spoke within 1 sample), medium (on both within 1 sample), high (on both at the same sample)")
 
 
 @dataclass(frozen=True, kw_only=True)
