@@ -178,6 +178,9 @@ class Radar:
     earth_curvature: bool = param(True, doc="4/3-earth radar horizon: what lies below it is not seen")
     beam_az_deg: float = param(5.2, doc="Horizontal -3 dB beam width, deg (18 in dome)", gt=0, le=45)
     beam_el_deg: float = param(25.0, doc="Vertical -3 dB beam width, deg", gt=0, le=90)
+    sidelobe_db: float = param(
+        -25.0, doc="One-way near-in sidelobe level of the horizontal antenna pattern, dB (Taylor taper; far sidelobes "
+        "fall below it)", ge=-45, le=-13)
     resolve_m: float = param(
         6.0, doc="Ray spacing across the beam at the range scale (or the horizon if nearer), m", gt=0, le=100,
         check=RESOLVE_CHECK)
