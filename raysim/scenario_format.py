@@ -159,7 +159,10 @@ class Interferer:
 @dataclass(frozen=True, kw_only=True)
 class Radar:
     enabled: bool = param(True, doc="Render this sensor")
-    model: Literal["broadband-4g", "broadband-3g"] = param("broadband-4g", doc="Radar model (Simrad/Navico Broadband class)")
+    model: Literal["broadband-4g", "broadband-3g", "magnetron"] = param(
+        "broadband-4g", doc="Radar model: broadband-4g / broadband-3g (Simrad/Navico Broadband class FMCW: Hann-windowed "
+        "FFT range sidelobes) or magnetron (a pulse set: pulse length by range scale); sets the receiver's range "
+        "response and saturation (docs/radar.md section 5)")
     rpm: float = param(24.0, doc="Antenna rotation, revolutions per minute", gt=0, le=120)
     range_m: float = param(1852.0, doc="Range scale: distance of the last sample, m", ge=50, le=66_672)
     spokes: int = param(2048, doc="Spokes per revolution", ge=64, le=8192)

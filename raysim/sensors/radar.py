@@ -45,6 +45,7 @@ from raysim.recording.npz import write_sweep
 from raysim.recording.ppi import PpiLabels, write_ppi
 from raysim.scene import NO_HIT, SEA_ID
 from raysim.sensors import radar_physics as phys
+from raysim.sensors import radar_receiver
 from raysim.sensors.carrier import CarrierScene
 from raysim.sensors.context import SensorContext
 from raysim.sensors.radar_facets import FacetTable
@@ -133,6 +134,8 @@ class RadarParams:
     elevation_max_deg: float = 20.0
     elevation_min_deg: float = -10.0
     rain_height_m: float = 1500.0  # top of the rain layer (unverified)
+    # receiver model (radar_receiver.RECEIVER_MODELS): range response and saturation level
+    model: str = "broadband-4g"
 
     @classmethod
     def from_config(cls, cfg) -> "RadarParams":
@@ -141,7 +144,7 @@ class RadarParams:
                    stc_a0_db=cfg.sea_clutter_control_db,
                    ftc_m=cfg.rain_clutter_control_m, blanking_m=cfg.blanking_m, multipath=cfg.multipath,
                    earth_curvature=cfg.earth_curvature, beam_az_deg=cfg.beam_az_deg, beam_el_deg=cfg.beam_el_deg,
-                   resolve_m=cfg.resolve_m)
+                   resolve_m=cfg.resolve_m, model=cfg.model)
 
 
 @dataclass
@@ -222,6 +225,10 @@ class RadarRenderer:
         self.texture_field = SeaTexture(self.seed, self.env.sea_state, self.env.wind_from_deg)
         # per-range receiver terms (the same every spoke)
         self.stc_db = phys.stc_gain_db(self.r64, p.stc_a0_db, p.stc_n, p.stc_r0_m).astype(np.float32)
+        # STC is a gain ahead of the limiting stage (the FMCW beat-signal high-pass before the ADC; the IF gain of a
+        # pulse set before its log amplifier), so saturation acts on the power after it
+        self.stc_lin = phys.undb(self.stc_db).astype(np.float32)
+        self.receiver = radar_receiver.RECEIVER_MODELS[p.model]
         self.rain_loss = phys.undb(-2.0 * float(phys.rain_attenuation_db_per_km(self.env.rain_mm_per_h)) / M_PER_KM
                                    * self.r64).astype(np.float32)
         self.rain_mean = None
@@ -300,7 +307,8 @@ class RadarRenderer:
         if self.env.rain_mm_per_h > 0:
             total = total * self.rain_loss[None, :]
         total = total + stream(self.seed, f"radar.noise.{rev}").standard_exponential((S, N), dtype=np.float32)
-        p_db = 10.0 * np.log10(np.maximum(total, np.float32(POWER_FLOOR)), dtype=np.float32) + self.stc_db[None, :]
+        total = radar_receiver.saturate(total * self.stc_lin[None, :], self.receiver.saturation_db)
+        p_db = 10.0 * np.log10(np.maximum(total, np.float32(POWER_FLOOR)), dtype=np.float32)
         if p.ftc_m > 0:
             p_db = self._ftc(p_db)
         echo = phys.quantise(p_db, p.video_floor_db, p.video_step_db)
