@@ -147,7 +147,10 @@ def build_parser() -> argparse.ArgumentParser:
     rcs.add_argument("--elevation-deg", type=float, default=0.0, help="radar elevation above the xy plane, deg")
     rcs.add_argument("--frequency-ghz", type=float, default=9.41, help="radar frequency, GHz")
     rcs.add_argument("--polarisation", default="HH", help="HH, VV, HV or VH")
-    rcs.add_argument("--sea", action="store_true", help="flat perfectly conducting sea at z = 0")
+    rcs.add_argument("--sea", action="store_true", help="sea at z = 0 (Fresnel reflection of sea water, rough)")
+    rcs.add_argument("--sea-state", type=float, default=3, help="Douglas sea state 0..6 of --sea (default 3)")
+    rcs.add_argument("--plating-rms-mm", type=float, default=3.0,
+                     help="rms unfairness of the plating, mm (default 3: ship plating; 0: smooth)")
     rcs.add_argument("--bounces", type=_count("--bounces"), default=3, help="maximum bounces per ray")
     rcs.add_argument("--ray-spacing-m", type=float, help="ray-tube side, m (default lambda/4, coarser for big meshes)")
     rcs.add_argument("--json", type=Path, help="also write the results as JSON")

@@ -1,7 +1,9 @@
 """``raysim rcs``: the monostatic RCS of a mesh file over a turn of aspects.
 
 Far field: the radar's wave is a plane wave (``--range-m`` is checked and reported against
-the far-field distance ``2 D^2 / lambda`` but does not change sigma).
+the far-field distance ``2 D^2 / lambda`` but does not change sigma). ``--sea``: Fresnel
+reflection of sea water times the rough-sea reduction of ``--sea-state`` (:mod:`raysim.rcs.sea`);
+``--plating-rms-mm``: the plating's unfairness (default 3 mm, ship plating; 0 for a smooth body).
 """
 
 from __future__ import annotations
@@ -59,6 +61,10 @@ def run(args) -> int:
     check_number("--elevation-deg", args.elevation_deg, 0.0 if args.sea else -89.0, 89.0)
     check_number("--frequency-ghz", args.frequency_ghz, 0.1, 300.0)
     check_number("--aspects", args.aspects, 1, 36000)
+    sea_state = check_number("--sea-state", args.sea_state, 0, 6)
+    if sea_state != int(sea_state):
+        raise InputError("command line", "--sea-state", f"must be an integer 0..6, got {sea_state:g}")
+    plating_rms_m = check_number("--plating-rms-mm", args.plating_rms_mm, 0.0, 100.0) * 1e-3
     if args.ray_spacing_m is not None:
         check_number("--ray-spacing-m", args.ray_spacing_m, 1e-4, 10.0)
     if args.polarisation not in POLARISATIONS:
@@ -72,16 +78,20 @@ def run(args) -> int:
     frequency = args.frequency_ghz * 1e9
     aspect, sigma = sweep(mesh.vertices_m, mesh.faces, args.aspects, elevation_deg=args.elevation_deg,
                           frequency_hz=frequency, polarisation=args.polarisation, gamma=gamma, sea=args.sea,
-                          n_bounces=args.bounces, spacing_m=args.ray_spacing_m)
+                          n_bounces=args.bounces, spacing_m=args.ray_spacing_m, sea_state=int(sea_state),
+                          plating_rms_m=plating_rms_m)
     size = float(np.linalg.norm(mesh.vertices_m.max(axis=0) - mesh.vertices_m.min(axis=0)))
     far = 2.0 * size**2 / (C_M_S / frequency)
     result = {"aspect_deg": aspect.tolist(), "rcs_m2": sigma.tolist(), "median_m2": float(np.median(sigma)),
               "min_m2": float(sigma.min()), "max_m2": float(sigma.max())}
+    where = f"over the sea (sea state {int(sea_state)})" if args.sea else "free space"
     print(f"{args.mesh}: {args.aspects} aspects, elevation {args.elevation_deg:g} deg, "
-          f"{args.frequency_ghz:g} GHz {args.polarisation}, {args.material}, {'over the sea' if args.sea else 'free space'}")
+          f"{args.frequency_ghz:g} GHz {args.polarisation}, {args.material}, plating rms "
+          f"{args.plating_rms_mm:g} mm, {where}")
     print(f"far field (plane wave); range {args.range_m:g} m, far-field distance 2 D^2 / lambda = {far:.0f} m")
     if args.sea:
-        print("sea: a flat, perfectly conducting plane (an upper bound: no Fresnel loss, no roughness; docs/radar.md)")
+        print("sea: Fresnel reflection of sea water (Klein and Swift 1977) times the Ament roughness reduction "
+              "at the grazing angle (docs/radar.md)")
     for key in ("median", "min", "max"):
         value = result[f"{key}_m2"]
         print(f"{key:>6}: {value:.4g} m^2  {_db(value)}")

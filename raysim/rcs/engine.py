@@ -14,6 +14,7 @@ import numpy as np
 
 from raysim.rcs.po import scattered_field
 from raysim.rcs.sbr import launch_grid, trace
+from raysim.rcs.sea import SeaSurface
 
 __all__ = ["C_M_S", "POLARISATIONS", "radar_frame", "monostatic_rcs", "default_spacing_m", "cull_under_sea"]
 
@@ -53,7 +54,8 @@ def cull_under_sea(vertices_m: np.ndarray, faces: np.ndarray) -> np.ndarray:
 def monostatic_rcs(
     vertices_m: np.ndarray, faces: np.ndarray, aspect_deg: float, elevation_deg: float = 0.0,
     frequency_hz: float = 9.41e9, polarisation: str = "HH", gamma: float = 1.0, sea: bool = False,
-    n_bounces: int = 3, spacing_m: float | None = None, max_tubes: int = 200_000,
+    n_bounces: int = 3, spacing_m: float | None = None, max_tubes: int = 200_000, sea_state: int = 3,
+    sea_conductor: bool = False, plating_rms_m: float = 0.0,
 ) -> float:
     """Monostatic RCS of a mesh seen from one direction, m^2.
 
@@ -72,13 +74,21 @@ def monostatic_rcs(
     gamma : float
         Amplitude reflection coefficient of the mesh material per bounce (1: perfect conductor).
     sea : bool
-        Flat perfectly conducting sea at z = 0 (faces wholly under it are dropped).
+        Sea at z = 0 (faces wholly under it are dropped): Fresnel reflection of sea water times
+        the rough-sea specular reduction (:class:`raysim.rcs.sea.SeaSurface`).
     n_bounces : int
         Maximum hits per ray tube (mesh and sea).
     spacing_m : float, optional
         Ray-tube side, m; default :func:`default_spacing_m`.
     max_tubes : int
         Tube budget for the default spacing.
+    sea_state : int
+        Douglas sea state 0..6 of the sea (roughness; 0: flat).
+    sea_conductor : bool
+        The sea is a flat perfect conductor instead (an upper bound).
+    plating_rms_m : float
+        rms unfairness (waviness) of the mesh's plating, m; reduces each mesh reflection to its
+        coherent part (:func:`raysim.rcs.sbr.trace`, :func:`raysim.rcs.po.scattered_field`).
 
     Returns
     -------
@@ -97,6 +107,8 @@ def monostatic_rcs(
     tx, rx = pol[polarisation[0]], pol[polarisation[1]]
     used = vertices_m[np.unique(faces)]
     origins, offset, centre = launch_grid(used, s, h, v, spacing, mirror_sea=sea)
-    bounces = trace(vertices_m, faces, origins, -s, tx, (h, v), gamma, n_bounces, sea)
-    field = scattered_field(bounces, k, spacing, gamma, s, centre, offset, sea)
+    surface = SeaSurface(sea_state, frequency_hz / 1e9, sea_conductor) if sea else None
+    k_rms = k * plating_rms_m
+    bounces = trace(vertices_m, faces, origins, -s, tx, (h, v), gamma, n_bounces, surface, k_rms)
+    field = scattered_field(bounces, k, spacing, gamma, s, centre, offset, surface, k_rms)
     return float(4.0 * math.pi * abs(np.dot(rx, field)) ** 2)

@@ -14,7 +14,9 @@ phase over the tube's footprint (``g`` the in-facet phase gradient, ``u, v`` the
 flat facet's PO integral is exact however coarse the tubes. The contributions of all tubes and
 all bounces are summed coherently and ``sigma = 4 pi |p . sum|^2`` (p the receive polarisation).
 Over a flat sea the field radiated towards the sea's mirror direction ``s'`` reaches the radar
-after a perfectly conducting reflection (image theory); it is added as a second term.
+after a reflection off the sea (image theory; Fresnel coefficients of sea water times the rough-sea
+specular reduction at the grazing angle = the elevation, :mod:`raysim.rcs.sea`); it is added as a
+second term.
 
 Source: H. Ling, R.-C. Chou and S.-W. Lee, "Shooting and bouncing rays: calculating the RCS
 of an arbitrarily shaped cavity", IEEE Trans. Antennas Propag. 37(2), 194-205, 1989; the
@@ -26,6 +28,7 @@ from __future__ import annotations
 import numpy as np
 
 from raysim.rcs.sbr import MeshHits
+from raysim.rcs.sea import SeaSurface
 
 __all__ = ["scattered_field"]
 
@@ -38,13 +41,13 @@ def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def _tube_field(
     hits: MeshHits, out: np.ndarray, k: float, spacing_m: float, gamma: float, ref_point: np.ndarray,
-    ref_offset_m: float, s_hat: np.ndarray,
+    ref_offset_m: float, s_hat: np.ndarray, sea: SeaSurface | None, k_rms: float,
 ) -> np.ndarray:
     """Sum (3,) complex of the PO far fields of ``hits`` radiated in direction ``out`` (3,).
 
     The return path length is measured to the launch plane ``ref_point + ref_offset_m * s_hat``
     along ``s_hat``; for ``out`` = the sea mirror of ``s_hat`` the hit point is mirrored
-    (image theory), which gives the path via the sea.
+    (image theory), which gives the path via the sea, and the sum is reflected off ``sea``.
     """
     d, n, e = hits.direction, hits.normal, hits.field
     cos_i = np.abs(_dot(n, d))
@@ -56,16 +59,17 @@ def _tube_field(
     g = (d - out) - n * (_dot(d - out, d) / _dot(n, d))[:, None]
     shape = np.sinc(k * _dot(g, hits.axis_u) * spacing_m / (2 * np.pi)) * np.sinc(
         k * _dot(g, hits.axis_v) * spacing_m / (2 * np.pi))
-    weight = gamma * spacing_m**2 / cos_i * shape * np.exp(-1j * k * (hits.path_m + back_m))
+    coherent = np.exp(-0.5 * (k_rms * (cos_i + np.abs(_dot(n, out)))) ** 2)  # rough plating (Beckmann)
+    weight = gamma * spacing_m**2 / cos_i * shape * coherent * np.exp(-1j * k * (hits.path_m + back_m))
     total = weight @ radiated  # (3,) complex
-    if image:  # the perfectly conducting sea reflects the field back towards s_hat
-        total = -total + 2.0 * total[2] * np.array([0.0, 0.0, 1.0])
+    if image:  # the sea reflects the field radiated along ``out`` back towards s_hat
+        total = sea.reflect(total[None, :], out[None, :])[0]
     return (-1j * k / (4.0 * np.pi)) * total
 
 
 def scattered_field(
     bounces: list[MeshHits], k: float, spacing_m: float, gamma: float, s_hat: np.ndarray,
-    ref_point: np.ndarray, ref_offset_m: float, sea: bool,
+    ref_point: np.ndarray, ref_offset_m: float, sea: SeaSurface | None, k_rms: float = 0.0,
 ) -> np.ndarray:
     """Coherent backscattered far field ``E_s R`` per unit incident field, (3,) complex, m.
 
@@ -85,8 +89,12 @@ def scattered_field(
         Centre of the launch grid, m.
     ref_offset_m : float
         Distance of the launch plane from ``ref_point`` along ``s_hat``, m.
-    sea : bool
+    sea : SeaSurface or None
         Add the paths that return via the sea (z = 0).
+    k_rms : float
+        Wavenumber times the rms unfairness of the plating, rad: each hit's radiation towards
+        ``out`` keeps the coherent fraction ``exp(-(k_rms (|n.d| + |n.out|))^2 / 2)`` (P. Beckmann
+        and A. Spizzichino, *The Scattering of Electromagnetic Waves from Rough Surfaces*, 1963).
 
     Returns
     -------
@@ -94,10 +102,10 @@ def scattered_field(
         ``sigma = 4 pi |p . E_s R|^2`` for receive polarisation ``p``.
     """
     total = np.zeros(3, dtype=complex)
-    outs = [s_hat] + ([s_hat * _MIRROR] if sea and s_hat[2] > 0.0 else [])
+    outs = [s_hat] + ([s_hat * _MIRROR] if sea is not None and s_hat[2] > 0.0 else [])
     for hits in bounces:
         if len(hits.point_m) == 0:
             continue
         for out in outs:
-            total += _tube_field(hits, out, k, spacing_m, gamma, ref_point, ref_offset_m, s_hat)
+            total += _tube_field(hits, out, k, spacing_m, gamma, ref_point, ref_offset_m, s_hat, sea, k_rms)
     return total

@@ -5,9 +5,10 @@ perpendicular to the radar direction over the target's projected extent. Each tu
 with Open3D's :class:`open3d.t.geometry.RaycastingScene` (Embree); at each hit it is reflected
 specularly, ``d' = d - 2 (d.n) n``, its electric-field vector is reflected as at a perfect
 conductor, ``E' = Gamma (-E + 2 (E.n) n)``, and it is recast from the hit point offset by a small
-epsilon, up to ``n_bounces`` hits. A flat sea (the plane z = 0) is an optional perfectly
-conducting mirror intersected analytically. Every mesh hit is handed to the physical-optics
-integration of :mod:`raysim.rcs.po`.
+epsilon, up to ``n_bounces`` hits. A flat sea (the plane z = 0) is an optional mirror
+intersected analytically, reflecting with the Fresnel coefficients of sea water times the
+rough-sea specular reduction (:class:`raysim.rcs.sea.SeaSurface`). Every mesh hit is handed to
+the physical-optics integration of :mod:`raysim.rcs.po`.
 
 Source: H. Ling, R.-C. Chou and S.-W. Lee, "Shooting and bouncing rays: calculating the RCS
 of an arbitrarily shaped cavity", IEEE Trans. Antennas Propag. 37(2), 194-205, 1989.
@@ -19,6 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 import open3d as o3d
+
+from raysim.rcs.sea import SeaSurface
 
 __all__ = ["MeshHits", "launch_grid", "trace"]
 
@@ -40,7 +43,7 @@ class MeshHits:
         Unit propagation direction of the incident tube.
     normal : (M, 3) float64
         Unit facet normal turned against the incident direction (``n . d < 0``).
-    field : (M, 3) float64
+    field : (M, 3) complex128
         Incident electric-field vector (amplitude includes the reflection coefficients so far).
     path_m : (M,) float64
         Path length from the launch (reference) plane to the hit, m.
@@ -134,7 +137,8 @@ def _cast(scene, o: np.ndarray, d: np.ndarray, t_far: np.ndarray, lo, hi) -> tup
 
 def trace(
     vertices_m: np.ndarray, faces: np.ndarray, origins_m: np.ndarray, direction: np.ndarray,
-    field: np.ndarray, axes: tuple[np.ndarray, np.ndarray], gamma: float, n_bounces: int, sea: bool,
+    field: np.ndarray, axes: tuple[np.ndarray, np.ndarray], gamma: float, n_bounces: int,
+    sea: SeaSurface | None, k_rms: float = 0.0,
 ) -> list[MeshHits]:
     """Trace a plane wave of ray tubes; return the mesh hits of every bounce.
 
@@ -156,8 +160,12 @@ def trace(
         Amplitude reflection coefficient of the mesh's material (1 for a perfect conductor).
     n_bounces : int
         Maximum number of hits (mesh or sea) per tube.
-    sea : bool
-        Reflect off the plane z = 0 (perfect conductor) too.
+    sea : SeaSurface or None
+        Reflect off the plane z = 0 too (Fresnel and roughness, or a perfect conductor).
+    k_rms : float
+        Wavenumber times the rms unfairness of the mesh's plating, rad: each mesh reflection's
+        coherent amplitude is multiplied by ``exp(-2 (k_rms cos theta_i)^2)`` (Kirchhoff
+        coherent reflection of a Gaussian rough surface; Ament 1953, Ruze 1966).
 
     Returns
     -------
@@ -171,10 +179,10 @@ def trace(
     n = len(origins_m)
     o = origins_m.copy()
     d = np.tile(direction, (n, 1))
-    e = np.tile(field, (n, 1))
+    e = np.tile(np.asarray(field, dtype=complex), (n, 1))
     au, av = np.tile(axes[0], (n, 1)), np.tile(axes[1], (n, 1))
     path = np.zeros(n)
-    if sea:  # start rays that begin under water further back along their line (path < 0 there)
+    if sea is not None:  # start rays that begin under water further back along their line (path < 0 there)
         below = o[:, 2] < 0.0
         if direction[2] < 0.0:
             back = (-o[below, 2] + EPSILON_M) / -direction[2]
@@ -188,7 +196,7 @@ def trace(
         if len(o) == 0:
             break
         t_sea = np.full(len(o), np.inf)
-        if sea:
+        if sea is not None:
             down = d[:, 2] < 0.0
             t_sea[down] = -o[down, 2] / d[down, 2]
         t_mesh, normal = _cast(scene, o, d, t_sea, lo, hi)
@@ -201,12 +209,15 @@ def trace(
         p = o + np.where(alive, t, 0.0)[:, None] * d
         m = on_mesh
         out.append(MeshHits(p[m], d[m], nrm[m], e[m], path[m] + t[m], au[m], av[m]))
-        amp = np.where(on_mesh, gamma, 1.0)[:, None]
-        e = amp * (-e + 2.0 * np.sum(e * nrm, axis=1, keepdims=True) * nrm)
+        e_sea = sea.reflect(e[on_sea], d[on_sea]) if on_sea.any() else None
+        coherent = gamma * np.exp(-2.0 * (k_rms * np.sum(d * nrm, axis=1, keepdims=True)) ** 2)
+        e = coherent * (-e + 2.0 * np.sum(e * nrm, axis=1, keepdims=True) * nrm)
+        if e_sea is not None:
+            e[on_sea] = e_sea
         d, au, av = _reflect(d, nrm), _reflect(au, nrm), _reflect(av, nrm)
         path = path + np.where(alive, t, 0.0)
         o = p + EPSILON_M * d
-        if sea:
+        if sea is not None:
             o[on_sea, 2] = np.maximum(o[on_sea, 2], EPSILON_M * 0.1)
         o, d, e, au, av, path = o[alive], d[alive], e[alive], au[alive], av[alive], path[alive]
     return out
