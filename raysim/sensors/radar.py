@@ -10,17 +10,19 @@ Per revolution (all spokes at once, numpy-vectorised):
    above the horizon and the rest aimed at the flat sea at geometrically spaced distances from
    the near edge of the -10 deg ray to 1.5 x the range scale, so low targets at every range are
    hit. All rays of a revolution go into ONE :meth:`CarrierScene.cast`.
-3. Targets: each object hit gives a facet RCS (:func:`radar_physics.facet_sigma_m2`) times the
-   two-way vertical gain at the ray's elevation in the antenna frame, through the radar
-   equation, into its range bin; hits below the 4/3-earth horizon are dropped. The azimuth beam
-   is applied as a circular convolution over spokes with the two-way Gaussian pattern, the range
-   point-spread (physical resolution) as a peak-1 Gaussian along range.
-4. Sea clutter: NRL sigma0 x cell area through the radar equation, K-distributed (Gamma texture
-   correlated over range and one beamwidth in azimuth, exponential speckle per spoke), only in
-   range bins before the first object hit of the spoke (radar shadow).
-5. Rain: two-way attenuation on every echo; volume clutter with exponential speckle.
-6. Receiver: thermal noise (exponential power, mean 1 = the noise level), STC, log video,
-   4-bit quantisation on fixed levels re. noise.
+3. Targets (:mod:`raysim.sensors.radar_targets`): coherent physical optics of the patches the rays light,
+   with the sea's image paths and a second specular bounce; summed with their phases per spoke and
+   range sample, convolved with the range impulse response of the model and over the spokes with the
+   two-way voltage pattern of the antenna (sidelobes included), through the radar equation.
+4. Sea clutter (:mod:`raysim.sensors.radar_clutter`): NRL sigma0 x cell area through the radar
+   equation with the GIT wind-direction factor, K-distributed (texture with Ward's shape per cell,
+   longer along the wave crests; exponential speckle per spoke), only before the first object hit of
+   the spoke (radar shadow).
+5. Rain (:mod:`raysim.sensors.radar_rain`): a uniform background and EXCELL cells drifting with the
+   wind; two-way path attenuation on every echo; volume clutter with exponential speckle.
+6. Receiver: thermal noise (exponential power, mean 1 = the noise level), other radars' pulses
+   (:mod:`raysim.sensors.radar_interference`), STC, saturation (:mod:`raysim.sensors.radar_receiver`),
+   FTC, log video, 4-bit quantisation on fixed levels re. noise, interference rejection.
 
 Outputs (docs/contracts.md, recording directory): ``radar/sweeps/NNNNNN.npz`` and ``radar/ppi/NNNNNN.png``.
 """
@@ -33,8 +35,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
-from scipy.ndimage import gaussian_filter1d, uniform_filter1d
-from scipy.signal import lfilter
+from scipy.signal import fftconvolve, lfilter
 
 from groundfloor.frames import mount_transform
 from groundfloor.recording import RADAR_SWEEP
@@ -43,23 +44,22 @@ from raysim.pose import heading_deg_from_yaw
 from raysim.random_streams import stream
 from raysim.recording.npz import write_sweep
 from raysim.recording.ppi import PpiLabels, write_ppi
-from raysim.scene import NO_HIT, SEA_ID
 from raysim.sensors import radar_physics as phys
 from raysim.sensors import radar_receiver
 from raysim.sensors.carrier import CarrierScene
 from raysim.sensors.context import SensorContext
-from raysim.sensors.radar_facets import FacetTable
-from raysim.sensors.radar_texture import SeaTexture
+from raysim.sensors.radar_beam import antenna_pattern, range_kernel
+from raysim.sensors.radar_clutter import SeaClutter
+from raysim.sensors.radar_interference import Interference, reject
+from raysim.sensors.radar_rain import RainEchoes, RainField
+from raysim.sensors.radar_targets import TargetEchoes
 from raysim.world import World
 
 
 #: mean of 10 log10 of exponential noise power of mean 1: -10 gamma / ln 10 (Euler's gamma), dB
 NOISE_LOG_MEAN_DB = -2.507
-#: Largest sea-clutter mean SNR, dB: far above video level 15 (about 55 dB) and far below float32's 385 dB.
-MAX_CLUTTER_DB = 200.0
 SECONDS_PER_MINUTE = 60.0
 DEG_PER_TURN = 360.0
-M_PER_KM = 1000.0
 #: Lowest antenna height the geometry uses, m: the ray fan's design height (a mount at or below the
 #: waterline still gets a fan) and, smaller, the height in the clutter tables (a grazing angle exists).
 FAN_MIN_HEIGHT_M = 0.1
@@ -68,28 +68,8 @@ CLUTTER_MIN_HEIGHT_M = 0.05
 #: scale still spread into its last bins through the range point-spread and the beam.
 CAST_RANGE_FACTOR = 1.5
 CAST_RANGE_MARGIN_M = 10.0
-#: Smallest grazing angle the clutter formulas are evaluated at, deg (below it log terms run away).
-MIN_GRAZING_DEG = 1e-3
-#: Steepest grazing angle of the NRL sea-clutter fit, deg (REF 3.7: 0.1 to 60 deg).
-NRL_MAX_GRAZING_DEG = 60.0
-#: Clutter mean beyond the horizon, dB: none, but finite so that it can be interpolated.
-NO_CLUTTER_DB = -300.0
 #: Floor of the summed power before taking dB (no log of 0).
 POWER_FLOOR = 1e-30
-#: Full width at half maximum of a Gaussian in standard deviations, 2 sqrt(2 ln 2).
-FWHM_PER_SIGMA = 2.3548
-#: The range point-spread is applied when its standard deviation is at least this many range bins.
-MIN_SPREAD_BINS = 0.3
-#: Steps of the clutter mean and texture across one azimuth beamwidth (formed on every sub-th spoke).
-CLUTTER_STEPS_PER_BEAM = 6
-#: Antenna height step of the clutter table's slope, m (the table at h_mid +- this).
-CLUTTER_HEIGHT_STEP_M = 0.05
-#: Grazing angles above this, deg, get the exact arcsine in the vertical pattern (the first range bins).
-STEEP_GRAZING_DEG = 10.0
-#: Swell angle that makes Ward's swell term vanish (cos(2 x 45 deg) = 0), deg: the swell term is added per spoke.
-NO_SWELL_DEG = 45.0
-#: Range bins of the moving average that normalises the texture's standard deviation along range.
-TEXTURE_STD_WINDOW_BINS = 33
 
 
 @dataclass(frozen=True)
@@ -136,6 +116,9 @@ class RadarParams:
     rain_height_m: float = 1500.0  # top of the rain layer (unverified)
     # receiver model (radar_receiver.RECEIVER_MODELS): range response and saturation level
     model: str = "broadband-4g"
+    # antenna (raysim.sensors.radar_antenna): one-way near-in sidelobe level of the horizontal pattern, dB;
+    # None = the sidelobe-free Gaussian beam of the earlier model (kept for comparisons)
+    sidelobe_db: float | None = -25.0
 
     @classmethod
     def from_config(cls, cfg) -> "RadarParams":
@@ -144,7 +127,7 @@ class RadarParams:
                    stc_a0_db=cfg.sea_clutter_control_db,
                    ftc_m=cfg.rain_clutter_control_m, blanking_m=cfg.blanking_m, multipath=cfg.multipath,
                    earth_curvature=cfg.earth_curvature, beam_az_deg=cfg.beam_az_deg, beam_el_deg=cfg.beam_el_deg,
-                   resolve_m=cfg.resolve_m, model=cfg.model)
+                   resolve_m=cfg.resolve_m, model=cfg.model, sidelobe_db=cfg.sidelobe_db)
 
 
 @dataclass
@@ -198,7 +181,6 @@ class RadarRenderer:
         self.r64 = np.maximum(self.range_m.astype(np.float64), 0.5 * self.dr)
         self.cell_m = max(self.dr, p.range_resolution_m)
         self.materials = material_table()
-        self.facets = FacetTable([o for o in world.objects if o.object_id != world.own_ship.object_id])
         # ray fan: dense enough to resolve p.resolve_m at the range scale or, if nearer, at the radar
         # horizon of a top_height_m object (beyond it nothing that tall is seen: REF 3.4)
         h = max(self.cfg.mount.z_m, FAN_MIN_HEIGHT_M)
@@ -211,38 +193,54 @@ class RadarRenderer:
         self.el_rad, self.d_el_rad = phys.elevation_grid_rad(h, resolve_range, p.resolve_m, p.top_height_m, p.low_height_m,
                                                              p.elevation_max_deg, p.elevation_min_deg)
         self.k = self.k_az * self.el_rad.size
-        # two-way azimuth pattern as a circular kernel over spokes (its FFT, reused every revolution)
-        offsets = np.arange(self.spokes)
-        offsets = np.where(offsets > self.spokes // 2, offsets - self.spokes, offsets) * spoke_deg
-        self.az_kernel_f = np.fft.rfft(phys.two_way_gain(offsets, p.beam_az_deg))
+        # antenna: the two-way VOLTAGE pattern as a circular kernel over spokes (its FFT, reused every revolution);
+        # the echoes are summed coherently: E[i] = sum_s g2(az_s - az_i) F[s] (a correlation)
+        self.pattern = antenna_pattern(p, self.seed)
+        kernel = self.pattern.spoke_kernel(self.spokes)
+        self.az_kernel_f = np.fft.fft(np.roll(kernel[::-1], 1))
+        self.az_power_kernel_f = np.fft.rfft(np.roll(np.abs(kernel[::-1]) ** 2, 1))
+        self.range_kernel, self.range_skirt_kernel = range_kernel(p, self.dr, self.cfg.range_m, self.samples)
         # clutter / rain cells use the -3 dB width as REF 3.7 does (R theta dR sec psi); the Gaussian
         # two-way pattern's equivalent width would be 0.753 theta3 (1.2 dB less): see docs/radar.md
         self.beam_eq_rad = math.radians(p.beam_az_deg)
         self.el_eq_rad = phys.two_way_equivalent_width_rad(p.beam_el_deg)
-        self.gamma = phys.GammaQuantiles()
         self.snr_kw = dict(pt_w=p.pt_w, gain_dbi=p.gain_dbi, f_ghz=p.f_ghz, sweep_s=p.sweep_s,
                            noise_figure_db=p.noise_figure_db, losses_db=p.losses_db)
-        self.texture_field = SeaTexture(self.seed, self.env.sea_state, self.env.wind_from_deg)
+        # sea clutter (docs/radar.md section 3): NRL mean x GIT wind direction, Ward-shaped K texture, speckle
+        self.sea_clutter = SeaClutter(self.range_m, self.spokes, self.cell_m, p, self.env.sea_state,
+                                      self.env.wind_from_deg, self.seed, self.snr_kw)
         # per-range receiver terms (the same every spoke)
         self.stc_db = phys.stc_gain_db(self.r64, p.stc_a0_db, p.stc_n, p.stc_r0_m).astype(np.float32)
         # STC is a gain ahead of the limiting stage (the FMCW beat-signal high-pass before the ADC; the IF gain of a
         # pulse set before its log amplifier), so saturation acts on the power after it
         self.stc_lin = phys.undb(self.stc_db).astype(np.float32)
         self.receiver = radar_receiver.RECEIVER_MODELS[p.model]
-        self.rain_loss = phys.undb(-2.0 * float(phys.rain_attenuation_db_per_km(self.env.rain_mm_per_h)) / M_PER_KM
-                                   * self.r64).astype(np.float32)
-        self.rain_mean = None
-        if self.env.rain_mm_per_h > 0:
-            volume = (self.r64 * self.beam_eq_rad * self.cell_m
-                      * np.minimum(self.r64 * self.el_eq_rad / 2.0, p.rain_height_m))
-            eta = phys.rain_eta_m2_per_m3(self.env.rain_mm_per_h, p.f_ghz)
-            self.rain_mean = phys.snr(eta * volume, self.r64, **self.snr_kw).astype(np.float32)
+        # rain (docs/radar.md section 4): uniform background plus drifting EXCELL cells; interference (other radars)
+        rain_volume = self.r64 * self.beam_eq_rad * self.cell_m * np.minimum(self.r64 * self.el_eq_rad / 2.0, p.rain_height_m)
+        self.rain = RainEchoes(RainField.from_environment(self.env, world.frame), self.range_m,
+                               phys.snr(rain_volume, self.r64, **self.snr_kw), p.f_ghz, self.spokes, p.beam_az_deg)
+        self.interference = Interference(self.cfg.interference, world.frame, self.seed, self.cfg.range_m, self.dr,
+                                         self.samples, p.beam_az_deg, own_pattern=self.pattern)
         self.blank = int(np.searchsorted(self.range_m, p.blanking_m, side="left"))
-        self._clutter_mean_db = self._clutter_mean_db_table(np.array([max(self.cfg.mount.z_m, CLUTTER_MIN_HEIGHT_M)]))[0]
+        self._clutter_mean_db = self.sea_clutter.mean_db_table(np.array([max(self.cfg.mount.z_m, CLUTTER_MIN_HEIGHT_M)]))[0]
         self.n_revolutions = int(math.floor(s.duration_s / self.rev_s + 1e-9))
+        self.targets = TargetEchoes(self)
         self.rev_wall_s: list[float] = []
 
     # ------------------------------------------------------------------ geometry
+
+    def range_filter(self, rows: np.ndarray) -> np.ndarray:
+        """Convolve (M, N) complex echoes along range with the range impulse response (same length)."""
+        half = self.range_kernel.size // 2
+        return fftconvolve(rows, self.range_kernel[None, :], mode="full", axes=1)[:, half: half + rows.shape[1]]
+
+    def range_skirt(self, power_rows: np.ndarray) -> np.ndarray | None:
+        """(M, N) incoherent range skirt (phase noise) of (M, N) echo powers; None if the model has none."""
+        if self.range_skirt_kernel is None:
+            return None
+        half = self.range_skirt_kernel.size // 2
+        out = fftconvolve(power_rows, self.range_skirt_kernel[None, :], mode="full", axes=1)
+        return out[:, half: half + power_rows.shape[1]].astype(np.float32)
 
     def _poses(self, t: np.ndarray):
         poses = self.world.own_ship.motion.poses(t)
@@ -274,15 +272,8 @@ class RadarRenderer:
         return t, azimuth, poses, rot, pos, o_w, d_w, o_b, d_b
 
     def _clutter_mean_db_table(self, antenna_h: np.ndarray) -> np.ndarray:
-        """(H, N) mean sea clutter, dB re. noise, at the level boresight: NRL sigma0 x cell area (no pattern)."""
-        p = self.p
-        psi = phys.grazing_angle_deg(antenna_h[:, None], self.r64[None, :])
-        psi_c = np.where(np.isfinite(psi), np.maximum(psi, MIN_GRAZING_DEG), 1.0)
-        area = phys.clutter_cell_area_m2(self.r64[None, :], psi_c, self.beam_eq_rad, self.cell_m)
-        # the NRL fit holds from 0.1 to 60 deg grazing (REF 3.7); steeper cells (the first metres) keep the 60 deg value
-        sigma0_db = phys.nrl_sigma0_db(np.minimum(psi_c, NRL_MAX_GRAZING_DEG), p.f_ghz, self.env.sea_state, p.polarisation)
-        mean_db = sigma0_db + phys.db(area) + phys.snr_db(1.0, self.r64[None, :], **self.snr_kw)
-        return np.where(np.isfinite(psi), mean_db, NO_CLUTTER_DB)  # beyond the horizon: none (finite, for interpolation)
+        """(H, N) mean sea clutter, dB re. noise, at the level boresight (:meth:`SeaClutter.mean_db_table`)."""
+        return self.sea_clutter.mean_db_table(antenna_h)
 
     # ------------------------------------------------------------------ one revolution
 
@@ -295,159 +286,34 @@ class RadarRenderer:
         antenna_h = np.maximum(pos[:, 2], CLUTTER_MIN_HEIGHT_M)
         max_range = self.cfg.range_m * CAST_RANGE_FACTOR + CAST_RANGE_MARGIN_M
         hits, on_carrier = self.scene.cast(o_w, d_w, np.repeat(t, K), o_b, d_b, max_range_m=max_range)
-        targets, first_hit, seen = self._targets(hits, on_carrier, t, o_w, d_w, antenna_h)
+        targets, first_hit, seen = self.targets.render(hits, on_carrier, t, o_w, d_w, antenna_h, rot, azimuth, max_range)
         clutter, texture = self._sea_clutter(rev, t, rot, pos, azimuth, heading, antenna_h, first_hit)
 
         # ---- receiver: rain clutter, attenuation, thermal noise, STC, FTC, log video, fixed 4-bit levels
         total = clutter
         if targets is not None:
             total = total + targets
-        if self.rain_mean is not None:
-            total = total + self.rain_mean[None, :] * stream(self.seed, f"radar.rain.{rev}").standard_exponential((S, N), dtype=np.float32)
-        if self.env.rain_mm_per_h > 0:
-            total = total * self.rain_loss[None, :]
+        rain_loss, rain_clutter = self.rain.revolution(self.seed, rev, t, pos, heading + azimuth)
+        if rain_clutter is not None:
+            total = total + rain_clutter
+        if rain_loss is not None:
+            total = total * rain_loss
+        if self.interference.active:
+            total = np.array(total, dtype=np.float32)  # a copy: the sea clutter array is also returned
+            self.interference.add_to(total, t, pos, heading + azimuth)
         total = total + stream(self.seed, f"radar.noise.{rev}").standard_exponential((S, N), dtype=np.float32)
         total = radar_receiver.saturate(total * self.stc_lin[None, :], self.receiver.saturation_db)
         p_db = 10.0 * np.log10(np.maximum(total, np.float32(POWER_FLOOR)), dtype=np.float32)
         if p.ftc_m > 0:
             p_db = self._ftc(p_db)
-        echo = phys.quantise(p_db, p.video_floor_db, p.video_step_db)
+        echo = reject(phys.quantise(p_db, p.video_floor_db, p.video_step_db), self.cfg.interference_rejection)
         echo[:, : self.blank] = 0
         return Revolution(echo, azimuth.astype(np.float32), heading.astype(np.float32), t, self.range_m,
                           p_db, first_hit, targets, texture, clutter, *seen)
 
-    def _targets(self, hits, on_carrier, t, o_w, d_w, antenna_h):
-        """(S, N) object echoes (SNR, linear; None if no object is hit), the first hit range per spoke, and
-        the objects seen: ((K,) int32 ids of the objects a ray reached, first along it and above the
-        radar horizon; (K,) int32 how many spokes reached each)."""
-        S, N, K = self.spokes, self.samples, self.k
-        p = self.p
-        oid = hits.object_id
-        h = np.flatnonzero((oid != NO_HIT) & (oid != SEA_ID) & ~on_carrier)
-        first_hit = np.full(S, np.inf)
-        nothing = (np.zeros(0, np.int32), np.zeros(0, np.int32))
-        if h.size == 0:
-            return None, first_hit, nothing
-        r_h = hits.range_m[h]
-        spoke_h = h // K
-        point = o_w[h] + r_h[:, None] * d_w[h]
-        if p.earth_curvature:  # below the 4/3-earth horizon: hidden (REF 3.4)
-            horiz = np.hypot(point[:, 0] - o_w[h, 0], point[:, 1] - o_w[h, 1])
-            visible = point[:, 2] >= phys.hidden_height_m(horiz, antenna_h[spoke_h])
-            h, r_h, spoke_h, point = h[visible], r_h[visible], spoke_h[visible], point[visible]
-            if h.size == 0:
-                return None, first_hit, nothing
-        np.minimum.at(first_hit, spoke_h, r_h)
-        pairs = np.unique(oid[h].astype(np.int64) * S + spoke_h)  # (object, spoke) pairs
-        seen_id, seen_spokes = np.unique(pairs // S, return_counts=True)
-        seen = (seen_id.astype(np.int32), seen_spokes.astype(np.int32))
-        el_idx = (h % K) % self.el_rad.size
-        normal = hits.normal[h].astype(np.float64)
-        cos_ray = -np.einsum("ij,ij->i", normal, d_w[h])
-        area_f, centre = self.facets.lookup(oid[h], hits.primitive[h], t[spoke_h])
-        los = centre - o_w[h]
-        cos_f = -np.einsum("ij,ij->i", normal, los) / np.maximum(np.linalg.norm(los, axis=1), 1e-9)
-        mat = hits.material[h]
-        footprint = r_h * r_h * self.d_az_rad * self.d_el_rad[el_idx]
-        sigma = phys.facet_sigma_m2(self.materials["radar_reflectivity_db"][mat], footprint, cos_ray,
-                                    self.materials["specular_exponent"][mat],
-                                    self.materials["radar_roughness_m"][mat], area_f, cos_f, r_h, p.f_ghz,
-                                    p.diffuse_gain)
-        sigma = sigma * phys.two_way_gain(np.degrees(self.el_rad[el_idx]), p.beam_el_deg)
-        if p.multipath:
-            sigma = sigma * phys.multipath_f4(antenna_h[spoke_h], point[:, 2], r_h, self.env.sea_state, p.f_ghz)
-        power = phys.snr(sigma, r_h, **self.snr_kw)
-        bins = np.rint(r_h / self.dr).astype(np.int64)
-        ok = bins < N
-        flat = spoke_h[ok] * N + bins[ok]
-        targets = np.bincount(flat, weights=power[ok], minlength=S * N).reshape(S, N)
-        # range point-spread (physical resolution, REF 3.3) on the spokes hit, when bins are finer than it
-        rows = np.unique(spoke_h[ok])
-        sigma_bins = p.range_resolution_m / FWHM_PER_SIGMA / self.dr
-        if sigma_bins > MIN_SPREAD_BINS and rows.size:
-            targets[rows] = gaussian_filter1d(targets[rows], sigma_bins, axis=1, mode="constant") * (
-                math.sqrt(2 * math.pi) * sigma_bins)
-        # azimuth beam: circular convolution over spokes, on the range bins that hold an echo
-        cols = np.flatnonzero(targets.any(axis=0))
-        if cols.size:
-            sub = np.fft.irfft(np.fft.rfft(targets[:, cols], axis=0) * self.az_kernel_f[:, None], n=S, axis=0)
-            targets[:, cols] = np.maximum(sub, 0.0)
-        return targets.astype(np.float32), first_hit, seen
-
     def _sea_clutter(self, rev, t, rot, pos, azimuth, heading, antenna_h, first_hit):
-        """(S, N) sea clutter SNR (K-distributed, zero in shadow and beyond the horizon) and its texture.
-
-        The mean level and the texture change smoothly over a beamwidth of spokes (the antenna's tilt and
-        height follow the ship's motion over seconds; the texture is averaged over the beam), so both are
-        formed on every ``sub``-th spoke and repeated; the speckle and the shadow are per spoke.
-        """
-        S, N = self.spokes, self.samples
-        p = self.p
-        beam_spokes = p.beam_az_deg / (DEG_PER_TURN / S)
-        sub = max(1, int(beam_spokes // CLUTTER_STEPS_PER_BEAM))  # 4 at 2048 spokes and 5.2 deg: 0.7 deg steps in a 5.2 deg beam
-        while S % sub:
-            sub -= 1
-        rows = np.arange(0, S, sub)
-        h_rows = antenna_h[rows]
-        # mean level: NRL sigma0 x cell area through the radar equation, linear in the antenna height about
-        # its mean over the revolution (heave, roll and pitch move it by decimetres)
-        h_mid = float(np.mean(antenna_h))
-        table = self._clutter_mean_db_table(np.array([h_mid - CLUTTER_HEIGHT_STEP_M, h_mid + CLUTTER_HEIGHT_STEP_M]))
-        slope = ((table[1] - table[0]) / (2.0 * CLUTTER_HEIGHT_STEP_M)).astype(np.float32)
-        dh = (h_rows - h_mid).astype(np.float32)
-        mean_db = (table.mean(axis=0).astype(np.float32))[None, :] + dh[:, None] * slope[None, :]
-        # vertical pattern at the sea cell's depression in the antenna frame (roll and pitch included)
-        psi = phys.grazing_angle_deg(h_mid, self.r64)
-        psi_r = np.radians(np.where(np.isfinite(psi), np.maximum(psi, MIN_GRAZING_DEG), 1.0)).astype(np.float32)
-        bearing = np.radians(azimuth[rows])
-        dxy = np.stack([np.cos(bearing), -np.sin(bearing), np.zeros(rows.size)], 1)  # horizontal boresight, sensor frame
-        bore = np.einsum("sij,sj->si", rot[rows], dxy)
-        bh = bore[:, :2] / np.maximum(np.linalg.norm(bore[:, :2], axis=1, keepdims=True), 1e-12)
-        z_ax = rot[rows, :, 2]  # the antenna's up axis in the world
-        sin_tilt = (z_ax[:, 0] * bh[:, 0] + z_ax[:, 1] * bh[:, 1]).astype(np.float32)
-        sin_el = np.cos(psi_r)[None, :] * sin_tilt[:, None] - np.sin(psi_r)[None, :] * z_ax[:, 2].astype(np.float32)[:, None]
-        # two-way Gaussian pattern in dB at the elevation asin(sin_el): ~ sin_el (0.5 % at 10 deg) except in the
-        # first, steep range bins
-        steep = int(np.count_nonzero(np.degrees(psi_r) > STEEP_GRAZING_DEG))
-        el_sq = sin_el * sin_el
-        el_sq[:, :steep] = np.arcsin(np.clip(sin_el[:, :steep], -1.0, 1.0)) ** 2
-        mean_db += np.float32(2.0 * phys.one_way_gain_db(math.degrees(1.0), p.beam_el_deg)) * el_sq
-        # no sea is nearer than the antenna is high: there the grazing geometry has no solution and the table runs
-        # away (278 dB at the antenna, 150 dB jumps per 0.1 m of height, overflowing float32 with the heave's slope;
-        # an inf poisons the FTC filter down the whole spoke); the cap keeps the rest of float32 finite
-        mean_db[:, self.range_m <= float(np.max(antenna_h))] = -np.inf
-        np.minimum(mean_db, np.float32(MAX_CLUTTER_DB), out=mean_db)
-        mean = np.power(np.float32(10.0), mean_db * np.float32(0.1))
-        texture = None
-        if self.env.sea_state > 0:
-            # texture: the sea's own field at the cells' world positions, averaged over the beam in azimuth
-            rng32 = self.range_m[None, :]
-            east = pos[rows, 0, None].astype(np.float32) + bh[:, 0, None].astype(np.float32) * rng32
-            north = pos[rows, 1, None].astype(np.float32) + bh[:, 1, None].astype(np.float32) * rng32
-            z = self.texture_field.sample(east, north, float(t[S // 2]))
-            # two passes of a moving average over one beamwidth (circular in azimuth; on the transposed,
-            # contiguous array), then unit variance again at each range
-            width = max(1, int(round(beam_spokes / sub)))
-            zt = np.ascontiguousarray(z.T)
-            zt = uniform_filter1d(uniform_filter1d(zt, width, axis=1, mode="wrap"), width, axis=1, mode="wrap")
-            std = np.maximum(uniform_filter1d(zt.std(axis=1), TEXTURE_STD_WINDOW_BINS, mode="nearest"), 1e-6)
-            z = np.ascontiguousarray((zt / std[:, None]).T)
-            # Ward's shape (REF 3.8) varies with range (grazing, cell area) and with the look direction to the swell
-            psi_c = np.where(np.isfinite(psi), np.maximum(psi, MIN_GRAZING_DEG), 1.0)
-            area = phys.clutter_cell_area_m2(self.r64, psi_c, self.beam_eq_rad, self.cell_m)
-            log_nu_r = np.log(phys.ward_shape_nu(psi_c, area, p.polarisation, NO_SWELL_DEG))  # cos(90 deg) = 0: no swell term
-            swell = -np.cos(np.radians(2.0 * ((azimuth[rows] + heading[rows]) - self.env.wind_from_deg))) / 3.0 * math.log(10.0)
-            texture = self.gamma(z, (log_nu_r[None, :] + swell[:, None]).astype(np.float32))
-            mean *= texture
-        clutter = np.repeat(mean, sub, axis=0) if sub > 1 else mean
-        if texture is not None:
-            clutter *= stream(self.seed, f"radar.clutter.{rev}").standard_exponential((S, N), dtype=np.float32)
-            texture = np.repeat(texture, sub, axis=0) if sub > 1 else texture
-        # radar shadow: no sea echo at or behind the first object hit of each spoke
-        hit_rows = np.flatnonzero(np.isfinite(first_hit))
-        if hit_rows.size:
-            clutter[hit_rows] *= self.range_m[None, :] < first_hit[hit_rows, None]
-        return clutter, texture
+        """(S, N) sea clutter SNR and its texture (:meth:`SeaClutter.render`)."""
+        return self.sea_clutter.render(rev, t, rot, pos, azimuth, heading, antenna_h, first_hit)
 
     def _ftc(self, p_db: np.ndarray) -> np.ndarray:
         """Rain control (FTC): subtract the log video's excess over the noise, low-passed along range (one-sided).

@@ -10,14 +10,11 @@ import math
 
 import numpy as np
 
-from raysim.sensors import radar_physics as phys
 
 __all__ = ["GaussianPattern", "antenna_pattern", "range_kernel"]
 
-#: Full width at half maximum of a Gaussian in standard deviations, 2 sqrt(2 ln 2).
-FWHM_PER_SIGMA = 2.3548
-#: Half-length of the Gaussian range kernel in standard deviations.
-GAUSS_HALF_SIGMAS = 5.0
+#: The coherent range response is cut where its power stays under this fraction of the peak (-80 dB).
+KERNEL_CUT = 1e-8
 
 
 class GaussianPattern:
@@ -59,16 +56,25 @@ def antenna_pattern(params, seed: int):
     return AntennaPattern(params.beam_az_deg, params.beam_el_deg, params.sidelobe_db, seed, params.f_ghz)
 
 
-def range_kernel(params, dr_m: float) -> np.ndarray:
-    """(L,) complex range impulse response (voltage, peak 1, centred, odd length) at the sample spacing ``dr_m``.
+def range_kernel(params, dr_m: float, range_scale_m: float, samples: int) -> tuple[np.ndarray, np.ndarray | None]:
+    """The range impulse response of ``params.model`` at the sample spacing ``dr_m``.
 
-    A Gaussian whose power has the range resolution as its FWHM (REF 3.3) unless the receiver model
-    gives its own (:mod:`raysim.sensors.radar_receiver`).
+    Returns
+    -------
+    coherent : (L,) float64
+        Voltage response (peak 1, centred, odd length; :func:`raysim.sensors.radar_receiver.range_response`),
+        cut where its power stays under ``KERNEL_CUT`` of the peak.
+    skirt : (M,) float64 or None
+        Incoherent power skirt (phase noise, sweep nonlinearity; :func:`raysim.sensors.radar_receiver.range_floor`),
+        None if the model has none.
     """
-    sigma_v = params.range_resolution_m / FWHM_PER_SIGMA * math.sqrt(2.0) / dr_m  # voltage sigma, samples
-    half = max(1, int(math.ceil(GAUSS_HALF_SIGMAS * sigma_v)))
-    x = np.arange(-half, half + 1)
-    return np.exp(-0.5 * (x / max(sigma_v, 1e-6)) ** 2).astype(complex)
+    from raysim.sensors import radar_receiver
 
-
-_ = phys  # the sources of the figures are in radar_physics
+    kw = dict(range_scale_m=range_scale_m, max_half_samples=samples)
+    coherent = radar_receiver.range_response(params.model, dr_m, params.range_resolution_m, **kw)
+    skirt = radar_receiver.range_floor(params.model, dr_m, params.range_resolution_m, **kw)
+    half = coherent.size // 2
+    strong = np.flatnonzero(coherent**2 >= KERNEL_CUT)
+    reach = int(np.max(np.abs(strong - half))) if strong.size else 0
+    coherent = coherent[half - reach: half + reach + 1]
+    return coherent, (skirt if np.any(skirt > 0) else None)

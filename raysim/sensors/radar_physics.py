@@ -240,56 +240,6 @@ def rain_eta_m2_per_m3(rain_mm_per_h, f_ghz: float = FREQUENCY_GHZ, k2: float = 
 # ------------------------------------------------------------------ targets (REF 3.6)
 
 
-def facet_sigma_m2(reflectivity_db, projected_area_m2, cos_ray, lobe_exponent, roughness_m, facet_area_m2,
-                   cos_facet, range_m, f_ghz: float = FREQUENCY_GHZ, diffuse_gain: float = 1.0):
-    """RCS of the surface patch one ray stands for: facet physical optics plus a rough-surface lobe.
-
-    ``sigma = rho a [q (4 pi A_f / lambda^2) cos(theta_f) exp(-k^2 A_f sin^2(theta_f) / 3) c
-    + (1 - q) D (4 (n + 2) / 3) cos^n(theta_ray)]``
-
-    - ``a = R^2 d_az d_el``: the ray's footprint across the ray (m^2);
-    - ``rho``: the material's power reflectivity re. metal (Fresnel; ice about -11 dB);
-    - ``q = exp(-(4 pi h cos(theta_f) / lambda)^2)``: the coherent fraction of a surface of rms
-      height ``h`` (Rayleigh roughness): painted plate is mirror-like, weathered ice fully rough;
-    - coherent part, physical optics of the flat facet of area ``A_f`` the ray hit (coplanar
-      triangles, :mod:`raysim.sensors.radar_facets`), seen at the incidence ``theta_f`` of the line
-      of sight to the facet's centre: summed over the rays that cover the facet
-      (``sum a = A_f cos theta_f``) it gives ``4 pi A_f^2 cos^2 / lambda^2`` at normal incidence,
-      the flat plate's RCS (REF 3.6), falling off as the Gaussian that matches the curvature of
-      the plate's ``sinc^2`` main lobe (``sinc^2 x ~ exp(-x^2/3)``, ``x = k sqrt(A_f) sin theta``).
-      That lobe is energy-consistent: a finely tessellated sphere sums to ``3 a^2``, near its PO
-      RCS ``pi a^2``, whatever the facet size. ``c = 1 / (1 + sigma_f / (pi R^2))`` caps a facet in
-      its own near field at the mirror limit ``pi R^2`` of an infinite plane at range R;
-    - incoherent part: the material's rough-surface lobe ``cos^n``, normalised so that its
-      integral over the hemisphere equals a Lambertian surface's (``4 cos`` per projected area at
-      ``n = 1``); ``D`` scales it (1; unverified).
-
-    Parameters
-    ----------
-    reflectivity_db, projected_area_m2, cos_ray, lobe_exponent, roughness_m, facet_area_m2, cos_facet, range_m : (H,) float
-        Per hit. Cosines of the incidence angles are clipped to [0, 1].
-    f_ghz : float
-    diffuse_gain : float
-
-    Returns
-    -------
-    (H,) float64, m^2
-    """
-    lam = wavelength_m(f_ghz)
-    k2 = (2.0 * math.pi / lam) ** 2
-    c_ray = np.clip(np.asarray(cos_ray, dtype=float), 0.0, 1.0)
-    c_f = np.clip(np.asarray(cos_facet, dtype=float), 0.0, 1.0)
-    n = np.asarray(lobe_exponent, dtype=float)
-    area_f = np.asarray(facet_area_m2, dtype=float)
-    q = np.exp(-(4.0 * math.pi * np.asarray(roughness_m, dtype=float) * c_f / lam) ** 2)
-    lobe = np.exp(-k2 * area_f * (1.0 - c_f * c_f) / 3.0)
-    sigma_facet = 4.0 * math.pi * area_f**2 * c_f * c_f / lam**2 * lobe
-    cap = 1.0 / (1.0 + sigma_facet / (math.pi * np.asarray(range_m, dtype=float) ** 2))
-    coherent = 4.0 * math.pi * area_f / lam**2 * c_f * lobe * cap
-    incoherent = diffuse_gain * (4.0 * (n + 2.0) / 3.0) * np.power(c_ray, n)
-    return undb(reflectivity_db) * np.asarray(projected_area_m2, dtype=float) * (q * coherent + (1.0 - q) * incoherent)
-
-
 def flat_plate_rcs_m2(area_m2: float, f_ghz: float = FREQUENCY_GHZ) -> float:
     """Normal-incidence RCS of a flat conducting plate, ``4 pi A^2 / lambda^2`` (REF 3.6)."""
     return 4.0 * math.pi * area_m2**2 / wavelength_m(f_ghz) ** 2

@@ -32,6 +32,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import scipy.fft
 
 from raysim.random_streams import stream
 from raysim.scene import NO_HIT, SEA_ID
@@ -44,6 +45,10 @@ __all__ = ["TargetEchoes", "sea_gamma"]
 BOUNCE_EPSILON_M = 1e-3
 #: Time step of the finite difference giving an object's velocity, s.
 VELOCITY_STEP_S = 0.05
+#: Echoes whose peak SNR stays under this (linear) are left out of the beam sum: at most 1 % of the noise power.
+INVISIBLE_SNR = 0.01
+#: Threads of the beam's FFTs over spokes.
+FFT_WORKERS = 2
 #: Roughness relief: wavevectors of the body-fixed random phase field (count, wavelength m, phase scale).
 RELIEF_WAVES = 8
 RELIEF_WAVELENGTH_M = 0.3
@@ -91,7 +96,7 @@ class TargetEchoes:
         dirs = rng.standard_normal((RELIEF_WAVES, 3))
         self.relief_k = dirs / np.linalg.norm(dirs, axis=1, keepdims=True) * (2.0 * math.pi / RELIEF_WAVELENGTH_M)
         self.relief_phase = rng.uniform(0.0, 2.0 * math.pi, RELIEF_WAVES)
-        self.snr_unit = phys.snr(1.0, renderer.r64, **renderer.snr_kw).astype(np.float64)  # (N,) per m^2
+        self.snr_amp = np.sqrt(phys.snr(1.0, renderer.r64, **renderer.snr_kw))  # (N,) sqrt(SNR) per sqrt(m^2)
 
     # ------------------------------------------------------------------ per hit
 
@@ -140,7 +145,7 @@ class TargetEchoes:
             Ids of the objects a ray reached (first along it, above the horizon) and on how many spokes.
         """
         r = self.r
-        S, N, K = r.spokes, r.samples, r.k
+        S, K = r.spokes, r.k
         oid = hits.object_id
         h = np.flatnonzero((oid != NO_HIT) & (oid != SEA_ID) & ~on_carrier)
         first_hit = np.full(S, np.inf)
@@ -169,10 +174,11 @@ class TargetEchoes:
         v_r = dot(velocity - ant_v[spoke], d_w[h])
         doppler = np.exp(1j * 2.0 * self.k * v_r * (t[spoke] - t[0]))
         amp = amp * doppler
-        field = self._deposit(spoke, rng_m, amp)
         if amp2 is not None:
-            field += self._deposit(spoke[keep2], rng2, amp2 * doppler[keep2])
-        return self._beam(field), first_hit, seen
+            spoke = np.concatenate([spoke, spoke[keep2]])
+            rng_m = np.concatenate([rng_m, rng2])
+            amp = np.concatenate([amp, amp2 * doppler[keep2]])
+        return self._beam(*self._deposit(spoke, rng_m, amp)), first_hit, seen
 
     def _first_bounce(self, h, r_h, spoke, point, hits, o_w, d_w, rot, azimuth, relief):
         """Complex amplitudes (H,) of the lit patches (four sea paths, rough lobe) and their ranges (H,), m."""
@@ -250,27 +256,65 @@ class TargetEchoes:
 
     # ------------------------------------------------------------------ sum, range and beam
 
-    def _deposit(self, spoke: np.ndarray, range_m: np.ndarray, amp: np.ndarray) -> np.ndarray:
-        """(S, N) complex128 sum of the amplitudes per spoke and nearest range sample (beyond the scale: dropped)."""
+    def _deposit(self, spoke: np.ndarray, range_m: np.ndarray, amp: np.ndarray):
+        """Sum the amplitudes per spoke and nearest range sample (beyond the scale: dropped).
+
+        Returns
+        -------
+        rows : (R,) int64
+            The spokes with an echo.
+        field : (R, N) complex64
+            Their summed amplitudes, sqrt(SNR) (through the radar equation at each echo's range).
+        """
+        N = self.r.samples
+        bins = np.rint(range_m / self.r.dr).astype(np.int64)
+        ok = bins < N
+        rows, row_of = np.unique(spoke[ok], return_inverse=True)
+        flat = row_of * N + bins[ok]
+        amp = amp[ok] * self.snr_amp[bins[ok]]  # sqrt(m^2) -> sqrt(SNR) through the radar equation at the echo's range
+        re = np.bincount(flat, weights=amp.real, minlength=rows.size * N)
+        im = np.bincount(flat, weights=amp.imag, minlength=rows.size * N)
+        field = np.empty(rows.size * N, np.complex64)
+        field.real, field.imag = re, im
+        return rows, field.reshape(rows.size, N)
+
+    def _beam(self, rows: np.ndarray, field: np.ndarray) -> np.ndarray | None:
+        """Range impulse response and two-way voltage beam over spokes, then power through the radar equation.
+
+        Parameters
+        ----------
+        rows : (R,) int64
+            Spokes of ``field``'s rows.
+        field : (R, N) complex64
+            Summed amplitudes per spoke and range sample, sqrt(m^2).
+
+        Returns
+        -------
+        (S, N) float32 or None
+            SNR (linear) of the object echoes; None if there is none.
+        """
         r = self.r
         S, N = r.spokes, r.samples
-        bins = np.rint(range_m / r.dr).astype(np.int64)
-        ok = bins < N
-        flat = spoke[ok] * N + bins[ok]
-        re = np.bincount(flat, weights=amp.real[ok], minlength=S * N)
-        im = np.bincount(flat, weights=amp.imag[ok], minlength=S * N)
-        return (re + 1j * im).reshape(S, N)
-
-    def _beam(self, field: np.ndarray) -> np.ndarray | None:
-        """Range impulse response and two-way voltage beam over spokes, then power through the radar equation."""
-        r = self.r
-        S = r.spokes
-        rows = np.flatnonzero(np.any(field != 0, axis=1))
         if rows.size == 0:
             return None
-        field[rows] = r.range_filter(field[rows])
-        cols = np.flatnonzero(np.any(field != 0, axis=0))
-        sub = np.fft.ifft(np.fft.fft(field[:, cols], axis=0) * r.az_kernel_f[:, None], n=S, axis=0)
-        power = np.zeros(field.shape, np.float32)
-        power[:, cols] = (sub.real**2 + sub.imag**2) * self.snr_unit[cols][None, :]
+        skirt = r.range_skirt(field.real**2 + field.imag**2)  # (R, N) incoherent range skirt, SNR
+        field = r.range_filter(field).astype(np.complex64)
+        power = np.zeros((S, N), np.float32)
+        # range samples whose strongest echo, even at the beam's peak, stays under INVISIBLE_SNR: left out
+        cols = np.flatnonzero((field.real**2 + field.imag**2).max(axis=0) > INVISIBLE_SNR)
+        if cols.size:
+            full = np.zeros((S, cols.size), np.complex64)
+            full[rows] = field[:, cols]
+            spectrum = scipy.fft.fft(full, axis=0, workers=FFT_WORKERS, overwrite_x=True)
+            spectrum *= r.az_kernel_f[:, None].astype(np.complex64)
+            sub = scipy.fft.ifft(spectrum, axis=0, workers=FFT_WORKERS, overwrite_x=True)
+            power[:, cols] = sub.real**2 + sub.imag**2
+        if skirt is not None:  # the skirt's power through the two-way power pattern
+            cols = np.flatnonzero(skirt.max(axis=0) > INVISIBLE_SNR)
+            if cols.size:
+                full = np.zeros((S, cols.size), np.float32)
+                full[rows] = skirt[:, cols]
+                spread = scipy.fft.irfft(scipy.fft.rfft(full, axis=0, workers=FFT_WORKERS)
+                                         * r.az_power_kernel_f[:, None], n=S, axis=0, workers=FFT_WORKERS)
+                power[:, cols] += np.maximum(spread, 0.0)
         return power

@@ -111,7 +111,9 @@ def test_sea_clutter_falls_with_range_rises_with_sea_state_and_is_absent_behind_
                               environment={"sea_state": 5, "wind_speed_mps": 12}, name="shadow")
     e = renderer.render_revolution(0)["echo"].astype(float)
     behind = e[around(90.0, 2)][:, int(250 / renderer.dr) : int(500 / renderer.dr)]
-    beside = e[around(270.0, 2)][:, int(250 / renderer.dr) : int(500 / renderer.dr)]
+    # the open sea beside: a sector of +-14 deg, not one beamwidth (K clutter of Ward's shape, about 0.2 here, leaves
+    # single beam-sized patches dark; issue 19)
+    beside = e[around(270.0, 20)][:, int(250 / renderer.dr) : int(500 / renderer.dr)]
     assert beside.mean() > 2 * behind.mean() + 0.5
 
 
@@ -136,7 +138,8 @@ def test_nrl_level_of_the_clutter_for_a_clean_geometry(tmp_path):
 
 
 def test_rain_attenuates_far_echoes_by_the_itu_two_way_loss(tmp_path):
-    target = hull(tmp_path, "far", 0.0, 1700.0, length=30.0, height=6.0)
+    # turned 45 deg off broadside: no hull-sea dihedral flash, so the echo (about 40 dB) stays below saturation
+    target = {**hull(tmp_path, "far", 0.0, 1700.0, length=30.0, height=6.0), "heading_deg": 45.0}
     peaks_db = []
     for rain, name in ((0.0, "dry"), (50.0, "wet")):
         renderer, _ = radar_world(tmp_path, obstacles=[target], name=name,
@@ -281,10 +284,16 @@ def plate(tmp_path, name, width_m, height_m, distance_m, centre_z_m, yaw_deg=0.0
             "heading_deg": 90.0 + yaw_deg}  # body x across the line of sight: the face looks at the radar
 
 
+#: Tubes of 5 cm at 200 m (3.7 cm at 150 m): the ray-tube count of a 0.5 m plate is then within a few per cent
+#: of its area, and a sphere's Fresnel zone (12.6 cm at 1 m radius) is sampled finely. The rough lobe of the
+#: metal (0.5 mm rms: 4 % of the power, with the random phases of its relief) is left out: these are PO checks.
+CALIBRATION = dict(resolve_m=0.05, diffuse_gain=0.0)
+
+
 def test_a_flat_plate_facing_the_radar_returns_its_analytic_rcs(tmp_path):
     from raysim.sensors import radar_physics as rp
 
-    r = fine_renderer(tmp_path, [plate(tmp_path, "plate", 0.5, 0.5, 150.0, 4.0)], "plate", multipath=False)
+    r = fine_renderer(tmp_path, [plate(tmp_path, "plate", 0.5, 0.5, 150.0, 4.0)], "plate", multipath=False, **CALIBRATION)
     got_db, at_m = peak_target_db(r)
     expected_db = rp.snr_db(rp.flat_plate_rcs_m2(0.25), at_m)  # 4 pi A^2 / lambda^2 = 771 m^2 (28.9 dBsm)
     assert abs(at_m - 149.975) < 2 * r.dr
@@ -294,48 +303,66 @@ def test_a_flat_plate_facing_the_radar_returns_its_analytic_rcs(tmp_path):
 def test_a_plate_turned_off_normal_falls_as_its_main_lobe(tmp_path):
     from raysim.sensors import radar_physics as rp
 
-    faces = fine_renderer(tmp_path, [plate(tmp_path, "faces", 0.5, 0.5, 150.0, 4.0)], "faces", multipath=False)
+    faces = fine_renderer(tmp_path, [plate(tmp_path, "faces", 0.5, 0.5, 150.0, 4.0)], "faces", multipath=False,
+                          **CALIBRATION)
     turned = fine_renderer(tmp_path, [plate(tmp_path, "turned", 0.5, 0.5, 150.0, 4.0, yaw_deg=0.75)], "turned",
-                           multipath=False)
-    # sinc^2(k L sin 0.75 deg) for L = 0.5 m: -2.6 dB (the model's Gaussian main lobe: -2.4 dB)
+                           multipath=False, **CALIBRATION)
+    # sinc^2(k L sin 0.75 deg) for L = 0.5 m: -2.6 dB, from the phases of the coherent sum over the tubes
     x = 2 * np.pi / rp.wavelength_m() * 0.5 * np.sin(np.radians(0.75))
     drop_db = peak_target_db(turned)[0] - peak_target_db(faces)[0]
     assert drop_db == pytest.approx(10 * np.log10((np.sin(x) / x) ** 2), abs=0.7)
 
 
-def test_a_metal_sphere_returns_pi_a_squared_whatever_its_tessellation(tmp_path):
+def sphere_obstacle(tmp_path, name, radius_m, centre_z_m, subdivisions=5):
     import trimesh
 
+    mesh = trimesh.creation.icosphere(subdivisions=subdivisions, radius=radius_m)
+    mesh.apply_translation((0.0, 0.0, centre_z_m))
+    mesh.export(tmp_path / f"{name}.stl")
+    return {"name": name, "kind": "mesh", "mesh": f"{name}.stl", "material": "aluminium",
+            "position": latlon(0.0, 150.0), "heading_deg": 0.0}
+
+
+def test_a_metal_sphere_returns_pi_a_squared(tmp_path):
+    # a smooth sphere: facets (4 cm) finer than its Fresnel zone; the echo is the coherent sum over the tubes
     from raysim.sensors import radar_physics as rp
 
-    for subdivisions in (3, 4):
-        mesh = trimesh.creation.icosphere(subdivisions=subdivisions, radius=1.0)
-        mesh.apply_translation((0.0, 0.0, 4.0))
-        mesh.export(tmp_path / f"sphere{subdivisions}.stl")
-        sphere = {"name": "sphere", "kind": "mesh", "mesh": f"sphere{subdivisions}.stl", "material": "aluminium",
-                  "position": latlon(0.0, 150.0), "heading_deg": 0.0}
-        r = fine_renderer(tmp_path, [sphere], f"sphere{subdivisions}", multipath=False)
-        got_db, at_m = peak_target_db(r)
-        # the sphere's echo spreads over ~1 m of range; the model's range point-spread (2.5 m) gathers it
-        assert got_db == pytest.approx(float(rp.snr_db(np.pi * 1.0**2, at_m)), abs=2.0), subdivisions
+    r = fine_renderer(tmp_path, [sphere_obstacle(tmp_path, "sphere", 1.0, 4.0)], "sphere", multipath=False,
+                      **CALIBRATION)
+    got_db, at_m = peak_target_db(r)
+    assert got_db == pytest.approx(float(rp.snr_db(np.pi * 1.0**2, at_m)), abs=2.0)
 
 
-def test_multipath_over_a_calm_sea_averages_six_over_a_lobe_and_nulls_the_waterline(tmp_path):
-    # two-ray over a mirror sea (REF 3.5): F^4 = 16 sin^4(2 pi ha ht / (lambda R)); ha 4 m, R 150 m: one lobe per
-    # 0.6 m of target height. Averaged over a whole lobe F^4 = 6 (+7.8 dB); near the waterline F^4 -> 0
+def test_multipath_lobes_a_small_sphere_and_nulls_it_at_the_waterline(tmp_path):
+    # two-ray over a mirror sea (REF 3.5): F^4 = 16 sin^4(2 pi ha ht / (lambda R)); ha 4 m, R 150 m: the first lobe
+    # peak at ht = lambda R / (4 ha) = 0.30 m (F^4 = 16, +12 dB); at the waterline F^4 -> 0. A sphere's specular
+    # points are at its centre's height: a 15 cm sphere centred there, and one half under water
     from raysim.sensors import radar_physics as rp
 
-    period_m = rp.wavelength_m() * 150.0 / (2 * 4.0)
-    cases = {"lobe": (period_m, period_m), "waterline": (0.15, 0.075)}
+    peak_m = rp.wavelength_m() * 150.0 / (4 * 4.0)
     gains = {}
-    for key, (height, centre) in cases.items():
-        obstacle = [plate(tmp_path, key, 3.0, height, 150.0, centre)]
-        on = fine_renderer(tmp_path, obstacle, key + "on", multipath=True)
-        off = fine_renderer(tmp_path, obstacle, key + "off", multipath=False)
+    for key, centre in {"peak": peak_m, "waterline": 0.0}.items():
+        obstacle = [sphere_obstacle(tmp_path, key, 0.15, centre, subdivisions=4)]
+        on = fine_renderer(tmp_path, obstacle, key + "on", multipath=True, **CALIBRATION)
+        off = fine_renderer(tmp_path, obstacle, key + "off", multipath=False, **CALIBRATION)
         gains[key] = peak_target_db(on)[0] - peak_target_db(off)[0]
-    assert gains["lobe"] == pytest.approx(10 * np.log10(6.0), abs=1.5)
-    assert gains["waterline"] < -10.0
+    assert gains["peak"] == pytest.approx(10 * np.log10(16.0), abs=2.0)
+    assert gains["waterline"] < -6.0
     assert rp.multipath_f4(4.0, 0.3, 150.0) == pytest.approx(16 * np.sin(2 * np.pi * 4 * 0.3 / (rp.wavelength_m() * 150)) ** 4, rel=1e-6)
+
+
+def test_a_vertical_plate_on_a_calm_sea_is_a_dihedral(tmp_path):
+    # plate + its sea image seen at grazing: one plate of twice the height, 4 pi (2 a b)^2 / lambda^2, from the
+    # bistatic sea paths; without the sea the plate is seen 1.5 deg from its normal: its narrow lobe, far weaker
+    from raysim.sensors import radar_physics as rp
+
+    a_m, b_m = 1.0, 0.5
+    obstacle = [plate(tmp_path, "wall", a_m, b_m, 150.0, b_m / 2)]
+    on = fine_renderer(tmp_path, obstacle, "wallon", multipath=True, **CALIBRATION)
+    off = fine_renderer(tmp_path, obstacle, "walloff", multipath=False, **CALIBRATION)
+    got_db, at_m = peak_target_db(on)
+    assert got_db == pytest.approx(float(rp.snr_db(rp.flat_plate_rcs_m2(2 * a_m * b_m), at_m)), abs=2.0)
+    assert peak_target_db(off)[0] < got_db - 10.0
 
 
 # ---------------------------------------------------------------- clutter texture and speckle (REF 3.8)
@@ -358,8 +385,10 @@ def test_rendered_clutter_is_k_distributed_with_wards_shape(tmp_path):
     assert np.quantile(u, [0.1, 0.5, 0.9]) == pytest.approx([0.1, 0.5, 0.9], abs=0.05)
     assert rev.texture[:, band].mean() == pytest.approx(1.0, abs=0.1)
     # speckle: given the texture, the intensity is exponential (second moment twice the squared mean)
+    # (the mean level varies with range and, GIT wind direction since issue 19, with azimuth: both divided out)
     x = rev.clutter[:, band] / rev.texture[:, band]
     x = x / x.mean(axis=0, keepdims=True)
+    x = x / x.mean(axis=1, keepdims=True)
     assert np.mean(x * x) == pytest.approx(2.0, rel=0.05)
 
 
@@ -367,14 +396,18 @@ def test_texture_is_correlated_in_time_speckle_is_not(tmp_path):
     r, _ = radar_world(tmp_path, environment={"sea_state": 4, "wind_speed_mps": 12}, name="t")
     band = (r.range_m > 200) & (r.range_m < 1000)
     revs = {k: r.revolution(k) for k in (0, 1, 12)}
+    # looking across the wind (from 0 deg), where the waves move across the beam-wide cells: 2.5 s apart the same
+    # waves, moved on a little; 30 s apart new waves. (Looking up or down wind the waves, correlated over a quarter
+    # of their 46 m wavelength along it since issue 19, move half a wavelength along range in 2.5 s.)
+    cross = np.concatenate([around(90.0, 40), around(270.0, 40)])
 
     def corr(a, b):  # of the log, each range bin's mean removed (the mean clutter level falls with range)
-        la, lb = np.log(a[:, band]), np.log(b[:, band])
+        la, lb = np.log(a[cross][:, band]), np.log(b[cross][:, band])
         la, lb = la - la.mean(axis=0), lb - lb.mean(axis=0)
         return float(np.corrcoef(la.ravel(), lb.ravel())[0, 1])
 
-    assert corr(revs[0].texture, revs[1].texture) > 0.5  # 2.5 s apart: the same waves, moved on a little
-    assert abs(corr(revs[0].texture, revs[12].texture)) < 0.15  # 30 s apart: new waves
+    assert corr(revs[0].texture, revs[1].texture) > 0.4
+    assert abs(corr(revs[0].texture, revs[12].texture)) < 0.15
     speckle0 = revs[0].clutter / revs[0].texture
     speckle1 = revs[1].clutter / revs[1].texture
     assert abs(corr(speckle0, speckle1)) < 0.05  # fresh speckle every spoke
