@@ -7,7 +7,7 @@ Per revolution, from the hits of the fan of rays (:meth:`raysim.sensors.radar.Ra
    :func:`raysim.sensors.radar_po.patch_amplitude`, with its phase ``exp(-j k L)``.
 2. **The sea's image** (multipath, REF 3.5): the four paths antenna -> patch -> antenna with either
    leg reflected by the sea, each with its own bistatic PO amplitude, the sea's reflection
-   coefficient ``Gamma`` (:func:`sea_gamma`) per sea leg and the vertical antenna pattern at each
+   coefficient ``Gamma`` (:func:`sea_gamma`: Fresnel of sea water times Ament) per sea leg and the vertical antenna pattern at each
    leg's elevation. A vertical wall over the sea is then the hull-sea dihedral it is, and low parts
    of a target fade in the two-ray nulls.
 3. **Second bounce** (shooting and bouncing rays): each lit patch reflects its tube specularly,
@@ -35,6 +35,7 @@ import numpy as np
 import scipy.fft
 
 from raysim.random_streams import stream
+from raysim.rcs.sea import sea_reflection_coefficient
 from raysim.scene import NO_HIT, SEA_ID
 from raysim.sensors import radar_physics as phys
 from raysim.sensors.radar_po import dot, patch_amplitude, reflect
@@ -55,20 +56,24 @@ RELIEF_WAVELENGTH_M = 0.3
 RELIEF_PHASE_SCALE = 2.0
 
 
-def sea_gamma(sin_grazing: np.ndarray, sea_state: int, f_ghz: float) -> np.ndarray:
-    """Amplitude reflection coefficient of the sea at low grazing (REF 3.5): ``-rho_Ament``.
+def sea_gamma(sin_grazing: np.ndarray, sea_state: int, f_ghz: float, pol: str = "HH") -> np.ndarray:
+    """Coherent amplitude reflection coefficient of the sea (REF 3.5): Fresnel of sea water times Ament's roughness.
+
+    :func:`raysim.rcs.sea.sea_reflection_coefficient` (Klein-Swift permittivity; near -1 for HH at low grazing).
 
     Parameters
     ----------
     sin_grazing : (M,) float
     sea_state : int
     f_ghz : float
+    pol : str
 
     Returns
     -------
-    (M,) float64
+    (M,) complex128
     """
-    return -phys.ament_factor(sea_state, np.clip(sin_grazing, 0.0, 1.0), f_ghz)
+    psi = np.arcsin(np.clip(np.asarray(sin_grazing, dtype=float), 0.0, 1.0))
+    return sea_reflection_coefficient(psi, pol, sea_state, f_ghz)
 
 
 def _unit(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -200,7 +205,7 @@ class TargetEchoes:
             o_img = o * np.array([1.0, 1.0, -1.0])
             d_img, l_img = _unit(point - o_img)
             sin_psi = d_img[:, 2]
-            gamma = sea_gamma(sin_psi, r.env.sea_state, r.p.f_ghz)
+            gamma = sea_gamma(sin_psi, r.env.sea_state, r.p.f_ghz, r.p.polarisation)
             el_i = el_d + (-np.arcsin(np.clip(sin_psi, -1, 1)) - np.arcsin(np.clip(d[:, 2], -1, 1)))
             g_i = self._v_gain(el_i) * gamma
             path += [(d_img, -d, l_img + r_h, g_i * g_d), (d, -d_img, r_h + l_img, g_d * g_i),
@@ -246,7 +251,7 @@ class TargetEchoes:
         outs = [(s_d, l_d, self._v_gain(np.arcsin(np.clip(-s_d[:, 2], -1, 1)) + tilt))]
         if r.p.multipath:
             s_i, l_i = _unit(o * np.array([1.0, 1.0, -1.0]) - p2)
-            gamma = sea_gamma(-s_i[:, 2], r.env.sea_state, r.p.f_ghz)
+            gamma = sea_gamma(-s_i[:, 2], r.env.sea_state, r.p.f_ghz, r.p.polarisation)
             outs.append((s_i, l_i, gamma * self._v_gain(np.arcsin(np.clip(-s_i[:, 2], -1, 1)) + tilt)))
         amp = np.zeros(keep.size, complex)
         for s_out, l_out, gain in outs:
