@@ -28,7 +28,14 @@ PALETTE = np.array([[40 * v, 40 + 215 * v, 20 + 60 * v] for v in np.arange(16) /
 BEARING_BINS = 7200  # 0.05 deg: finer than the finest spoke spacing drawn (8192 spokes: 0.044 deg ~ one bin)
 FONT_PX = 13  # Pillow's bundled font (the same glyphs everywhere: the pictures stay byte-identical)
 TEXT = (170, 215, 170)
+RING = (70, 110, 70)
+RING_LABEL = (120, 170, 120)
+HEADING_LINE = (200, 200, 200)
 LINE_PX = 16
+#: the picture is a palette PNG: 16 video levels, black outside the display, then the annotation colours
+#: (a quarter of the bytes of RGB to encode; every viewer and ROS image decoder reads palette PNGs)
+OUTSIDE, TEXT_INK, RING_INK, RING_LABEL_INK, HEADING_INK = range(16, 21)
+IMAGE_PALETTE = np.concatenate([PALETTE, np.array([(0, 0, 0), TEXT, RING, RING_LABEL, HEADING_LINE], np.uint8)])
 
 
 @dataclass(frozen=True)
@@ -83,7 +90,7 @@ def _corner_text(draw: ImageDraw.ImageDraw, size_px: int, corner: str, lines: li
     for k, line in enumerate(lines):
         y = 6 + k * LINE_PX if top else size_px - 6 - (len(lines) - k) * LINE_PX
         x = 6 if corner[1] == "l" else size_px - 6 - draw.textlength(line, font=font)
-        draw.text((x, y), line, fill=TEXT, font=font)
+        draw.text((x, y), line, fill=TEXT_INK, font=font)
 
 
 def _annotate(draw: ImageDraw.ImageDraw, size_px: int, range_m: np.ndarray, heading_deg: float,
@@ -104,17 +111,17 @@ def _annotate(draw: ImageDraw.ImageDraw, size_px: int, range_m: np.ndarray, head
 
 @lru_cache(maxsize=4)
 def _pixel_geometry(size_px: int, samples: int, range_scale_m: float):
-    """Per pixel (flattened): bearing bin, sample index, inside the range scale (cached per display)."""
+    """The pixels inside the range scale (flat indices) with their bearing bin and sample index (cached per display)."""
     half = size_px / 2.0
     y, x = np.mgrid[0:size_px, 0:size_px]
     dx, dy = x - half + 0.5, half - y - 0.5
-    radius = np.hypot(dx, dy) / half * range_scale_m
-    bearing = np.degrees(np.arctan2(dx, dy)) % 360.0
-    bins = (np.floor(bearing / 360.0 * BEARING_BINS).astype(np.int64) % BEARING_BINS).ravel()
+    radius = (np.hypot(dx, dy) / half * range_scale_m).ravel()
+    bearing = (np.degrees(np.arctan2(dx, dy)) % 360.0).ravel()
+    inside = np.flatnonzero(radius <= range_scale_m)
+    bins = np.floor(bearing[inside] / 360.0 * BEARING_BINS).astype(np.int64) % BEARING_BINS
     range_m = np.arange(samples) * (range_scale_m / (samples - 1))
-    sample = np.clip(np.searchsorted(range_m, radius), 0, samples - 1).ravel()
-    inside = (radius <= range_scale_m).ravel()
-    return bins, sample, inside
+    sample = np.clip(np.searchsorted(range_m, radius[inside]), 0, samples - 1)
+    return inside, bins, sample
 
 
 def ppi_image(echo: np.ndarray, azimuth_deg: np.ndarray, heading_deg: np.ndarray, range_m: np.ndarray,
@@ -138,23 +145,23 @@ def ppi_image(echo: np.ndarray, azimuth_deg: np.ndarray, heading_deg: np.ndarray
     """
     spokes, samples = echo.shape
     half = size_px / 2.0
-    bins, sample, inside = _pixel_geometry(size_px, samples, float(range_m[-1]))
+    flat_inside, bins, sample = _pixel_geometry(size_px, samples, float(range_m[-1]))
     # the spoke whose true bearing is nearest (at or after) each bearing bin's centre
     true = (np.asarray(heading_deg, dtype=float) + azimuth_deg) % 360.0
     order = np.argsort(true, kind="stable")
     centres = (np.arange(BEARING_BINS) + 0.5) * (360.0 / BEARING_BINS)
     spoke_of_bin = order[np.searchsorted(true[order], centres) % spokes]
-    level = np.where(inside, echo[spoke_of_bin[bins], sample], 0)
-    rgb = PALETTE[level]
-    rgb[~inside] = 0
-    image = Image.fromarray(rgb.reshape(size_px, size_px, 3))
+    level = np.full(size_px * size_px, OUTSIDE, np.uint8)
+    level[flat_inside] = np.ascontiguousarray(echo, dtype=np.uint8).ravel().take(spoke_of_bin[bins] * samples + sample)
+    image = Image.fromarray(level.reshape(size_px, size_px))  # "L"; putpalette makes it "P"
+    image.putpalette(IMAGE_PALETTE.ravel().tolist())
     draw = ImageDraw.Draw(image)
     for quarter in (1, 2, 3, 4):
         r = half * quarter / 4
-        draw.ellipse([half - r, half - r, half + r, half + r], outline=(70, 110, 70))
-        draw.text((half + 4, half - r + 2), f"{_nm(range_m[-1] * quarter / 4)} NM", fill=(120, 170, 120))
+        draw.ellipse([half - r, half - r, half + r, half + r], outline=RING_INK)
+        draw.text((half + 4, half - r + 2), f"{_nm(range_m[-1] * quarter / 4)} NM", fill=RING_LABEL_INK)
     h = np.radians(heading_deg[0])
-    draw.line([half, half, half + half * np.sin(h), half - half * np.cos(h)], fill=(200, 200, 200))
+    draw.line([half, half, half + half * np.sin(h), half - half * np.cos(h)], fill=HEADING_INK)
     _annotate(draw, size_px, range_m, float(heading_deg[0]), None if time_s is None else float(time_s[0]), labels)
     return image
 

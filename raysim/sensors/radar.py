@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import math
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -48,7 +49,7 @@ from raysim.sensors import radar_physics as phys
 from raysim.sensors import radar_receiver
 from raysim.sensors.carrier import CarrierScene
 from raysim.sensors.context import SensorContext
-from raysim.sensors.radar_beam import antenna_pattern, range_kernel
+from raysim.sensors.radar_beam import antenna_pattern, block_kernel, convolve_rows_sparse, range_kernel
 from raysim.sensors.radar_clutter import SeaClutter
 from raysim.sensors.radar_interference import Interference, reject
 from raysim.sensors.radar_rain import RainEchoes, RainField
@@ -70,6 +71,8 @@ CAST_RANGE_FACTOR = 1.5
 CAST_RANGE_MARGIN_M = 10.0
 #: Floor of the summed power before taking dB (no log of 0).
 POWER_FLOOR = 1e-30
+#: Range samples per block of the incoherent range skirt (a smooth pedestal: formed on blocks, repeated).
+SKIRT_BLOCK = 8
 
 
 @dataclass(frozen=True)
@@ -142,10 +145,18 @@ class Revolution:
     snr_db: np.ndarray = field(repr=False, default=None)  # (S, N) float32, before quantisation (STC, FTC applied)
     first_hit_m: np.ndarray = field(repr=False, default=None)  # (S,) first object hit (inf: none)
     target_snr: np.ndarray = field(repr=False, default=None)  # (S, N) float32, object echoes alone (linear, re. noise)
-    texture: np.ndarray = field(repr=False, default=None)  # (S, N) float32, clutter texture (mean 1) or None
+    texture_rows: np.ndarray = field(repr=False, default=None)  # (S / sub, N) float32, texture on formed spokes
     clutter: np.ndarray = field(repr=False, default=None)  # (S, N) float32, sea clutter alone (linear, re. noise)
     object_id: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int32))  # (K,) int32, objects the rays hit
     object_spokes: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int32))  # (K,) int32, spokes hitting each
+    texture_sub: int = 1  # the texture is formed on every sub-th spoke and repeated
+
+    @property
+    def texture(self) -> np.ndarray | None:
+        """(S, N) float32 clutter texture (mean 1) of every spoke, or None (sea state 0)."""
+        if self.texture_rows is None or self.texture_sub == 1:
+            return self.texture_rows
+        return np.repeat(self.texture_rows, self.texture_sub, axis=0)
 
     def arrays(self) -> dict:
         return {"echo": self.echo, "azimuth_deg": self.azimuth_deg, "heading_deg": self.heading_deg,
@@ -198,8 +209,10 @@ class RadarRenderer:
         self.pattern = antenna_pattern(p, self.seed)
         kernel = self.pattern.spoke_kernel(self.spokes)
         self.az_kernel_f = np.fft.fft(np.roll(kernel[::-1], 1))
-        self.az_power_kernel_f = np.fft.rfft(np.roll(np.abs(kernel[::-1]) ** 2, 1))
+        # the two-way POWER pattern at each spoke offset, for incoherent echoes (the range skirt): P[(i - s) % S]
+        self.az_power_pattern = np.roll(np.abs(kernel[::-1]) ** 2, 1).astype(np.float32)
         self.range_kernel, self.range_skirt_kernel = range_kernel(p, self.dr, self.cfg.range_m, self.samples)
+        self.range_skirt_blocks = block_kernel(self.range_skirt_kernel, SKIRT_BLOCK)
         # clutter / rain cells use the -3 dB width as REF 3.7 does (R theta dR sec psi); the Gaussian
         # two-way pattern's equivalent width would be 0.753 theta3 (1.2 dB less): see docs/radar.md
         self.beam_eq_rad = math.radians(p.beam_az_deg)
@@ -230,17 +243,30 @@ class RadarRenderer:
     # ------------------------------------------------------------------ geometry
 
     def range_filter(self, rows: np.ndarray) -> np.ndarray:
-        """Convolve (M, N) complex echoes along range with the range impulse response (same length)."""
-        half = self.range_kernel.size // 2
-        return fftconvolve(rows, self.range_kernel[None, :], mode="full", axes=1)[:, half: half + rows.shape[1]]
+        """Convolve (M, N) complex echoes (sparse: point echoes) along range with the range impulse response."""
+        return convolve_rows_sparse(rows, self.range_kernel)
 
     def range_skirt(self, power_rows: np.ndarray) -> np.ndarray | None:
-        """(M, N) incoherent range skirt (phase noise) of (M, N) echo powers; None if the model has none."""
-        if self.range_skirt_kernel is None:
+        """(M, B) incoherent range skirt (phase noise) of (M, N) echo powers in blocks of SKIRT_BLOCK samples.
+
+        The skirt is a smooth Lorentzian pedestal 65 dB under its echo (docs/radar.md section 5): it changes by
+        under 2 dB over a block, so it is formed on blocks (echo powers summed per block, the kernel averaged over
+        each block offset) and repeated over the block's samples (:meth:`unblock`). None if the model has none.
+        """
+        if self.range_skirt_blocks is None:
             return None
-        half = self.range_skirt_kernel.size // 2
-        out = fftconvolve(power_rows, self.range_skirt_kernel[None, :], mode="full", axes=1)
-        return out[:, half: half + power_rows.shape[1]].astype(np.float32)
+        m, n = power_rows.shape
+        blocks = -(-n // SKIRT_BLOCK)
+        padded = np.zeros((m, blocks * SKIRT_BLOCK), np.float32)
+        padded[:, :n] = power_rows
+        per_block = padded.reshape(m, blocks, SKIRT_BLOCK).sum(axis=2)
+        half = self.range_skirt_blocks.size // 2
+        out = fftconvolve(per_block, self.range_skirt_blocks[None, :], mode="full", axes=1)[:, half: half + blocks]
+        return np.maximum(out, 0.0).astype(np.float32)
+
+    def unblock(self, blocks: np.ndarray) -> np.ndarray:
+        """(M, N) samples of (M, B) values per SKIRT_BLOCK-sample block (:meth:`range_skirt`)."""
+        return np.repeat(blocks, SKIRT_BLOCK, axis=1)[:, : self.samples]
 
     def _poses(self, t: np.ndarray):
         poses = self.world.own_ship.motion.poses(t)
@@ -278,42 +304,90 @@ class RadarRenderer:
     # ------------------------------------------------------------------ one revolution
 
     def revolution(self, rev: int) -> Revolution:
-        """Render revolution ``rev`` (deterministic: its random streams are named after it)."""
-        S, N, K = self.spokes, self.samples, self.k
-        p = self.p
+        """Render revolution ``rev`` (deterministic: its random streams are named after it).
+
+        The sea clutter and the receiver noise (numpy work that releases the GIL) are formed on a second thread
+        while this one casts the rays and forms the object echoes; the shadow of the objects is cut into the
+        clutter once both are done. Every random draw comes from a stream named after its job and the revolution,
+        so the bytes do not depend on the threads' timing.
+        """
+        K = self.k
         t, azimuth, poses, rot, pos, o_w, d_w, o_b, d_b = self.rays(rev)
         heading = heading_deg_from_yaw(poses.yaw_rad)
         antenna_h = np.maximum(pos[:, 2], CLUTTER_MIN_HEIGHT_M)
         max_range = self.cfg.range_m * CAST_RANGE_FACTOR + CAST_RANGE_MARGIN_M
-        hits, on_carrier = self.scene.cast(o_w, d_w, np.repeat(t, K), o_b, d_b, max_range_m=max_range)
-        targets, first_hit, seen = self.targets.render(hits, on_carrier, t, o_w, d_w, antenna_h, rot, azimuth, max_range)
-        clutter, texture = self._sea_clutter(rev, t, rot, pos, azimuth, heading, antenna_h, first_hit)
+        with ThreadPoolExecutor(max_workers=1, thread_name_prefix="radar-clutter") as pool:
+            sea = pool.submit(self._sea_and_noise, rev, t, rot, pos, azimuth, heading, antenna_h)
+            hits, on_carrier = self.scene.cast(o_w, d_w, np.repeat(t, K), o_b, d_b, max_range_m=max_range)
+            targets, first_hit, seen = self.targets.render(hits, on_carrier, t, o_w, d_w, antenna_h, rot, azimuth,
+                                                           max_range)
+            clutter, texture, noise = sea.result()
+        self.sea_clutter.shadow(clutter, first_hit)
 
         # ---- receiver: rain clutter, attenuation, thermal noise, STC, FTC, log video, fixed 4-bit levels
-        total = clutter
-        if targets is not None:
-            total = total + targets
+        # one fresh (S, N) array, worked in place from here (the clutter and target arrays are returned as they are)
+        total = clutter + targets if targets is not None else clutter.copy()
         rain_loss, rain_clutter = self.rain.revolution(self.seed, rev, t, pos, heading + azimuth)
         if rain_clutter is not None:
-            total = total + rain_clutter
+            total += rain_clutter
         if rain_loss is not None:
-            total = total * rain_loss
+            total *= rain_loss
         if self.interference.active:
-            total = np.array(total, dtype=np.float32)  # a copy: the sea clutter array is also returned
             self.interference.add_to(total, t, pos, heading + azimuth)
-        total = total + stream(self.seed, f"radar.noise.{rev}").standard_exponential((S, N), dtype=np.float32)
-        total = radar_receiver.saturate(total * self.stc_lin[None, :], self.receiver.saturation_db)
-        p_db = 10.0 * np.log10(np.maximum(total, np.float32(POWER_FLOOR)), dtype=np.float32)
-        if p.ftc_m > 0:
-            p_db = self._ftc(p_db)
-        echo = reject(phys.quantise(p_db, p.video_floor_db, p.video_step_db), self.cfg.interference_rejection)
+        p_db, levels = self._video(total, noise)
+        echo = reject(levels, self.cfg.interference_rejection)
         echo[:, : self.blank] = 0
         return Revolution(echo, azimuth.astype(np.float32), heading.astype(np.float32), t, self.range_m,
-                          p_db, first_hit, targets, texture, clutter, *seen)
+                          snr_db=p_db, first_hit_m=first_hit, target_snr=targets, texture_rows=texture, clutter=clutter,
+                          object_id=seen[0], object_spokes=seen[1], texture_sub=self.sea_clutter.sub)
 
-    def _sea_clutter(self, rev, t, rot, pos, azimuth, heading, antenna_h, first_hit):
-        """(S, N) sea clutter SNR and its texture (:meth:`SeaClutter.render`)."""
-        return self.sea_clutter.render(rev, t, rot, pos, azimuth, heading, antenna_h, first_hit)
+    def _video(self, total: np.ndarray, noise: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Receiver from the echo power to the 4-bit video, in place, on two halves of the spokes in two threads.
+
+        Noise, STC, saturation, log video, FTC and the fixed levels act spoke by spoke (the FTC along range), so
+        the halves are independent.
+
+        Parameters
+        ----------
+        total : (S, N) float32
+            Echo power (SNR, linear) of the revolution without the noise; becomes the log video, dB re. noise.
+        noise : (S, N) float32
+            Thermal noise power (exponential, mean 1).
+
+        Returns
+        -------
+        p_db : (S, N) float32
+            ``total``: the power over the noise, dB, after STC, saturation and FTC.
+        levels : (S, N) uint8
+            Video levels 0..15.
+        """
+        p = self.p
+
+        def halve(rows: slice) -> np.ndarray:
+            block = total[rows]
+            block += noise[rows]
+            block *= self.stc_lin[None, :]
+            radar_receiver.saturate(block, self.receiver.saturation_db, out=block)
+            # 10 log10 P as (10 / ln 10) ln P: numpy's float32 log is vectorised, its log10 is not (3x slower)
+            np.log(np.maximum(block, np.float32(POWER_FLOOR), out=block), out=block)
+            block *= np.float32(10.0 / math.log(10.0))
+            if p.ftc_m > 0:
+                block[...] = self._ftc(block)
+            return phys.quantise(block, p.video_floor_db, p.video_step_db)
+
+        half = slice(self.spokes // 2, None)
+        with ThreadPoolExecutor(max_workers=1, thread_name_prefix="radar-video") as pool:
+            second = pool.submit(halve, half)
+            first = halve(slice(0, self.spokes // 2))
+            levels = np.concatenate([first, second.result()])
+        return total, levels
+
+    def _sea_and_noise(self, rev, t, rot, pos, azimuth, heading, antenna_h):
+        """The revolution's sea clutter without shadow, its texture and the (S, N) thermal noise (exponential)."""
+        clutter, texture = self.sea_clutter.render(rev, t, rot, pos, azimuth, heading, antenna_h, None)
+        noise = stream(self.seed, f"radar.noise.{rev}").standard_exponential((self.spokes, self.samples),
+                                                                             dtype=np.float32)
+        return clutter, texture, noise
 
     def _ftc(self, p_db: np.ndarray) -> np.ndarray:
         """Rain control (FTC): subtract the log video's excess over the noise, low-passed along range (one-sided).
@@ -336,21 +410,36 @@ class RadarRenderer:
     # ------------------------------------------------------------------ the run
 
     def run(self, out_dir: Path, progress=None) -> dict:
-        """Render every complete revolution into ``out_dir/radar``; returns counts for the manifest."""
+        """Render every complete revolution into ``out_dir/radar``; returns counts for the manifest.
+
+        A revolution's NPZ sweep and PPI picture are written by one writer thread while the next revolution
+        renders (compression and PNG encoding release the GIL); at most one revolution waits to be written.
+        """
         radar_dir = Path(out_dir) / "radar"
         sweeps_dir, ppi_dir = radar_dir / "sweeps", radar_dir / "ppi"
         sweeps_dir.mkdir(parents=True, exist_ok=True)
         ppi_dir.mkdir(parents=True, exist_ok=True)
+        labels = PpiLabels.from_scenario(self.world.scenario)
         counts = {"sweeps": 0, "spokes": 0}
         revs = range(self.n_revolutions)
-        for rev in (progress(revs) if progress else revs):
-            started = time.perf_counter()
-            out = self.revolution(rev)
-            write_sweep(sweeps_dir, rev, RADAR_SWEEP, out.arrays())
-            write_ppi(ppi_dir / f"{rev:06d}.png", out.arrays(), PpiLabels.from_scenario(self.world.scenario))
-            counts["sweeps"] += 1
-            counts["spokes"] += self.spokes
-            self.rev_wall_s.append(time.perf_counter() - started)
+
+        def write(rev: int, arrays: dict) -> None:
+            write_sweep(sweeps_dir, rev, RADAR_SWEEP, arrays)
+            write_ppi(ppi_dir / f"{rev:06d}.png", arrays, labels)
+
+        pending = None
+        with ThreadPoolExecutor(max_workers=1, thread_name_prefix="radar-writer") as writer:
+            for rev in (progress(revs) if progress else revs):
+                started = time.perf_counter()
+                arrays = self.revolution(rev).arrays()
+                if pending is not None:
+                    pending.result()  # a write's error surfaces here, before the next is queued
+                pending = writer.submit(write, rev, arrays)
+                counts["sweeps"] += 1
+                counts["spokes"] += self.spokes
+                self.rev_wall_s.append(time.perf_counter() - started)
+            if pending is not None:
+                pending.result()
         return counts
 
 

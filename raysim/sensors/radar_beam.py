@@ -78,3 +78,67 @@ def range_kernel(params, dr_m: float, range_scale_m: float, samples: int) -> tup
     reach = int(np.max(np.abs(strong - half))) if strong.size else 0
     coherent = coherent[half - reach: half + reach + 1]
     return coherent, (skirt if np.any(skirt > 0) else None)
+
+
+def convolve_rows_sparse(rows: np.ndarray, kernel: np.ndarray) -> np.ndarray:
+    """Convolve each row of a sparse (M, N) array with a centred odd kernel (``'same'`` size, zeros beyond the ends).
+
+    The target field of a revolution holds a few thousand non-zero cells in some 500 x 1024: spreading each
+    non-zero cell over the kernel's taps costs (cells x taps) instead of an FFT of every row.
+
+    Parameters
+    ----------
+    rows : (M, N) float or complex
+        The array (mostly zeros).
+    kernel : (L,) float
+        Centred kernel, L odd.
+
+    Returns
+    -------
+    (M, N) array of the type of ``rows``
+        ``out[m, n] = sum_k rows[m, n - k] kernel[k + L // 2]``, k from -L // 2 to L // 2.
+    """
+    m, n = rows.shape
+    half = kernel.size // 2
+    flat = np.flatnonzero(rows)
+    cols = flat % n
+    taps = np.arange(-half, half + 1)
+    target = cols[:, None] + taps[None, :]  # (Q, L) column each tap lands on
+    inside = (target >= 0) & (target < n)
+    where = (flat[:, None] + taps[None, :])[inside]
+    values = (rows.reshape(-1)[flat][:, None] * kernel[None, :])[inside]
+    if np.iscomplexobj(rows):
+        out = np.empty(m * n, rows.dtype)
+        out.real = np.bincount(where, weights=values.real, minlength=m * n)
+        out.imag = np.bincount(where, weights=values.imag, minlength=m * n)
+    else:
+        out = np.bincount(where, weights=values, minlength=m * n).astype(rows.dtype)
+    return out.reshape(m, n)
+
+
+def block_kernel(kernel: np.ndarray | None, block: int) -> np.ndarray | None:
+    """A centred odd kernel on blocks of ``block`` samples: the mean of its taps over each block offset.
+
+    The response at any sample of block ``b`` to unit power anywhere in block ``b0`` is taken as the mean of
+    ``kernel`` over the offsets ``(b - b0) block + (-block/2 .. block/2)``; right for a kernel that changes little
+    over a block (the range skirt's Lorentzian pedestal).
+
+    Parameters
+    ----------
+    kernel : (2 H + 1,) float or None
+    block : int
+        Samples per block.
+
+    Returns
+    -------
+    (2 J + 1,) float32 or None
+        J = ceil(H / block) blocks each way; None if ``kernel`` is None.
+    """
+    if kernel is None:
+        return None
+    half = kernel.size // 2
+    reach = -(-half // block)
+    padded = np.zeros(2 * reach * block + block)
+    start = reach * block + block // 2 - half
+    padded[start: start + kernel.size] = kernel
+    return padded.reshape(2 * reach + 1, block).mean(axis=1).astype(np.float32)

@@ -238,7 +238,7 @@ class SeaClutter:
         return np.maximum(texture, np.float32(TEXTURE_FLOOR), out=texture)
 
     def render(self, rev: int, t: np.ndarray, rot: np.ndarray, pos: np.ndarray, azimuth_deg: np.ndarray,
-               heading_deg: np.ndarray, antenna_h_m: np.ndarray, first_hit_m: np.ndarray):
+               heading_deg: np.ndarray, antenna_h_m: np.ndarray, first_hit_m: np.ndarray | None):
         """Sea clutter SNR of one revolution (K-distributed, zero in shadow and beyond the horizon) and its texture.
 
         Parameters
@@ -257,15 +257,16 @@ class SeaClutter:
             Own-ship heading per spoke, deg (the look direction comes from ``rot``; kept for the interface).
         antenna_h_m : (S,) float
             Antenna height above the sea per spoke, m.
-        first_hit_m : (S,) float
-            Range of the first object hit per spoke, m (inf: none).
+        first_hit_m : (S,) float or None
+            Range of the first object hit per spoke, m (inf: none); None leaves the shadow to :meth:`shadow`.
 
         Returns
         -------
         clutter : (S, N) float32
             Sea clutter SNR, linear re. noise.
-        texture : (S, N) float32 or None
-            The Gamma texture (mean 1); None at sea state 0.
+        texture : (S / sub, N) float32 or None
+            The Gamma texture (mean 1) on the formed spokes (every ``sub``-th, repeated over the ``sub`` spokes
+            from it); None at sea state 0.
         """
         S, N = self.spokes, self.samples
         rows = self.rows
@@ -277,9 +278,20 @@ class SeaClutter:
         clutter = np.repeat(mean, self.sub, axis=0) if self.sub > 1 else mean
         if texture is not None:
             clutter *= stream(self.seed, f"radar.clutter.{rev}").standard_exponential((S, N), dtype=np.float32)
-            texture = np.repeat(texture, self.sub, axis=0) if self.sub > 1 else texture
-        # radar shadow: no sea echo at or behind the first object hit of each spoke
+        if first_hit_m is not None:
+            self.shadow(clutter, first_hit_m)
+        return clutter, texture
+
+    def shadow(self, clutter: np.ndarray, first_hit_m: np.ndarray) -> None:
+        """Radar shadow, in place: no sea echo at or behind the first object hit of each spoke.
+
+        Parameters
+        ----------
+        clutter : (S, N) float32
+            Sea clutter SNR of the revolution.
+        first_hit_m : (S,) float
+            Range of the first object hit per spoke, m (inf: none).
+        """
         hit_rows = np.flatnonzero(np.isfinite(first_hit_m))
         if hit_rows.size:
             clutter[hit_rows] *= self.range_m[None, :] < first_hit_m[hit_rows, None]
-        return clutter, texture

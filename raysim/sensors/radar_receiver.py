@@ -291,7 +291,7 @@ def apply_range_response(amplitude: np.ndarray, model: str, dr_m: float, range_r
                           range_floor(model, dr_m, range_resolution_m, **kw))
 
 
-def saturate(power: np.ndarray, saturation_db: float, p: float = RAPP_P) -> np.ndarray:
+def saturate(power: np.ndarray, saturation_db: float, p: float = RAPP_P, out: np.ndarray | None = None) -> np.ndarray:
     """Receiver limiter (Rapp 1991): ``P / (1 + (P / P_sat)^p)^(1/p)``, ``P_sat = 10^(saturation_db / 10)``.
 
     Monotonic; the identity far below ``P_sat`` (relative error ``(P / P_sat)^p / p``); never above ``P_sat``,
@@ -305,12 +305,17 @@ def saturate(power: np.ndarray, saturation_db: float, p: float = RAPP_P) -> np.n
         Limit over the noise, dB.
     p : float
         Smoothness (the larger, the harder the knee).
+    out : (S, N) float32, optional
+        Where to write (may be ``power`` itself); by default a new array.
 
     Returns
     -------
     (S, N) float32
     """
-    out = np.array(power, dtype=np.float32)  # a copy
+    if out is None:
+        out = np.array(power, dtype=np.float32)  # a copy
+    elif out is not power:
+        out[...] = power
     # below LIMITER_ACTIVE x P_sat the gain differs from 1 by less than float32's resolution: only the rest is
     # computed, in float64 (r^p overflows float32, and its rounding would break monotonicity near P_sat)
     p_sat = 10.0 ** (saturation_db / 10.0)

@@ -102,6 +102,9 @@ class TargetEchoes:
         self.relief_k = dirs / np.linalg.norm(dirs, axis=1, keepdims=True) * (2.0 * math.pi / RELIEF_WAVELENGTH_M)
         self.relief_phase = rng.uniform(0.0, 2.0 * math.pi, RELIEF_WAVES)
         self.snr_amp = np.sqrt(phys.snr(1.0, renderer.r64, **renderer.snr_kw))  # (N,) sqrt(SNR) per sqrt(m^2)
+        self._az_kernel_f = renderer.az_kernel_f.astype(np.complex64)[:, None]  # (S, 1) voltage pattern spectrum
+        skirt = renderer.range_skirt_kernel
+        self._skirt_peak = 0.0 if skirt is None else float(np.max(skirt))
 
     # ------------------------------------------------------------------ per hit
 
@@ -283,6 +286,39 @@ class TargetEchoes:
         field.real, field.imag = re, im
         return rows, field.reshape(rows.size, N)
 
+    def _add_skirt(self, power: np.ndarray, rows: np.ndarray, field: np.ndarray) -> None:
+        """Add the incoherent range skirt (phase noise) of the strong echoes, through the two-way power pattern.
+
+        Only cells whose skirt can rise over INVISIBLE_SNR are spread (the skirt is -65 dB under its echo: echoes
+        over about 45 dB): along range by :meth:`RadarRenderer.range_skirt` (on blocks of samples), over spokes by one
+        matrix product with the power pattern, on the spokes where the pattern can lift the strongest skirt over
+        INVISIBLE_SNR (the main lobe: the skirt's sidelobes would be some 115 dB under its echo).
+
+        Parameters
+        ----------
+        power : (S, N) float32
+            SNR of the object echoes, added to in place.
+        rows : (R,) int64
+            Spokes of ``field``'s rows.
+        field : (R, N) complex64
+            Summed amplitudes per spoke and range sample before the range response, sqrt(SNR).
+        """
+        r = self.r
+        if r.range_skirt_kernel is None:
+            return
+        cell_power = field.real**2 + field.imag**2
+        strong = cell_power * np.float32(self._skirt_peak) > INVISIBLE_SNR
+        strong_rows = np.flatnonzero(strong.any(axis=1))
+        if strong_rows.size == 0:
+            return
+        skirt = r.range_skirt(np.where(strong[strong_rows], cell_power[strong_rows], np.float32(0.0)))  # (R', B)
+        S = r.spokes
+        reach = np.flatnonzero(r.az_power_pattern * skirt.max() > INVISIBLE_SNR)  # spoke offsets that count
+        spokes = rows[strong_rows]
+        out = np.unique((spokes[:, None] + reach[None, :]) % S)
+        pattern = r.az_power_pattern[(out[:, None] - spokes[None, :]) % S]  # (O, R') float32, >= 0
+        power[out] += r.unblock(pattern @ skirt)
+
     def _beam(self, rows: np.ndarray, field: np.ndarray) -> np.ndarray | None:
         """Range impulse response and two-way voltage beam over spokes, then power through the radar equation.
 
@@ -302,24 +338,30 @@ class TargetEchoes:
         S, N = r.spokes, r.samples
         if rows.size == 0:
             return None
-        skirt = r.range_skirt(field.real**2 + field.imag**2)  # (R, N) incoherent range skirt, SNR
-        field = r.range_filter(field).astype(np.complex64)
         power = np.zeros((S, N), np.float32)
+        self._add_skirt(power, rows, field)
+        field = r.range_filter(field).astype(np.complex64)
         # range samples whose strongest echo, even at the beam's peak, stays under INVISIBLE_SNR: left out
         cols = np.flatnonzero((field.real**2 + field.imag**2).max(axis=0) > INVISIBLE_SNR)
         if cols.size:
             full = np.zeros((S, cols.size), np.complex64)
             full[rows] = field[:, cols]
             spectrum = scipy.fft.fft(full, axis=0, workers=FFT_WORKERS, overwrite_x=True)
-            spectrum *= r.az_kernel_f[:, None].astype(np.complex64)
+            spectrum *= self._az_kernel_f
             sub = scipy.fft.ifft(spectrum, axis=0, workers=FFT_WORKERS, overwrite_x=True)
-            power[:, cols] = sub.real**2 + sub.imag**2
-        if skirt is not None:  # the skirt's power through the two-way power pattern
-            cols = np.flatnonzero(skirt.max(axis=0) > INVISIBLE_SNR)
-            if cols.size:
-                full = np.zeros((S, cols.size), np.float32)
-                full[rows] = skirt[:, cols]
-                spread = scipy.fft.irfft(scipy.fft.rfft(full, axis=0, workers=FFT_WORKERS)
-                                         * r.az_power_kernel_f[:, None], n=S, axis=0, workers=FFT_WORKERS)
-                power[:, cols] += np.maximum(spread, 0.0)
+            _add_columns(power, cols, sub.real**2 + sub.imag**2)
         return power
+
+
+def _add_columns(power: np.ndarray, cols: np.ndarray, values: np.ndarray) -> None:
+    """``power[:, cols] += values`` by runs of consecutive columns (slices: a fancy column index is slow).
+
+    Parameters
+    ----------
+    power : (S, N) float32
+    cols : (C,) int, increasing
+    values : (S, C) float32
+    """
+    breaks = np.flatnonzero(np.diff(cols) > 1) + 1
+    for a, b in zip(np.r_[0, breaks], np.r_[breaks, cols.size]):  # a few runs per object in range
+        power[:, cols[a]: cols[b - 1] + 1] += values[:, a:b]
