@@ -242,9 +242,10 @@ class RadarRenderer:
 
     # ------------------------------------------------------------------ geometry
 
-    def range_filter(self, rows: np.ndarray) -> np.ndarray:
-        """Convolve (M, N) complex echoes (sparse: point echoes) along range with the range impulse response."""
-        return convolve_rows_sparse(rows, self.range_kernel)
+    def range_filter(self, rows: np.ndarray, cells: np.ndarray | None = None) -> np.ndarray:
+        """Convolve (M, N) complex echoes (sparse: point echoes at the flat indices ``cells``, if known) along range
+        with the range impulse response."""
+        return convolve_rows_sparse(rows, self.range_kernel, cells)
 
     def range_skirt(self, power_rows: np.ndarray) -> np.ndarray | None:
         """(M, B) incoherent range skirt (phase noise) of (M, N) echo powers in blocks of SKIRT_BLOCK samples.
@@ -291,7 +292,7 @@ class RadarRenderer:
         azimuth = idx * (DEG_PER_TURN / S)
         poses, rot, pos = self._poses(t)
         d_s = self._sensor_directions(azimuth)  # (S, K, 3)
-        d_w = np.einsum("sij,skj->ski", rot, d_s).reshape(S * K, 3)
+        d_w = (d_s @ rot.transpose(0, 2, 1)).reshape(S * K, 3)  # each spoke's rows times its rotation's transpose
         o_w = np.repeat(pos, K, axis=0)
         d_b = d_s.reshape(S * K, 3) @ self.mount_rotation.T
         o_b = np.broadcast_to(self.mount_translation, (S * K, 3))
@@ -383,11 +384,16 @@ class RadarRenderer:
         return total, levels
 
     def _sea_and_noise(self, rev, t, rot, pos, azimuth, heading, antenna_h):
-        """The revolution's sea clutter without shadow, its texture and the (S, N) thermal noise (exponential)."""
-        clutter, texture = self.sea_clutter.render(rev, t, rot, pos, azimuth, heading, antenna_h, None)
-        noise = stream(self.seed, f"radar.noise.{rev}").standard_exponential((self.spokes, self.samples),
-                                                                             dtype=np.float32)
-        return clutter, texture, noise
+        """The revolution's sea clutter without shadow, its texture and the (S, N) thermal noise.
+
+        Sea clutter and receiver noise are both circular Gaussian voltages in a cell, so the power of their sum is
+        exponential with the sum of their means: one exponential draw (stream ``radar.noise.<rev>``) is the
+        speckle of both, ``(c + 1) E`` (the clutter's share ``c E`` is returned as the clutter).
+        """
+        speckle = stream(self.seed, f"radar.noise.{rev}").standard_exponential((self.spokes, self.samples),
+                                                                               dtype=np.float32)
+        clutter, texture = self.sea_clutter.render(rev, t, rot, pos, azimuth, heading, antenna_h, None, speckle)
+        return clutter, texture, speckle
 
     def _ftc(self, p_db: np.ndarray) -> np.ndarray:
         """Rain control (FTC): subtract the log video's excess over the noise, low-passed along range (one-sided).

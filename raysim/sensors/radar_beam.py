@@ -80,7 +80,7 @@ def range_kernel(params, dr_m: float, range_scale_m: float, samples: int) -> tup
     return coherent, (skirt if np.any(skirt > 0) else None)
 
 
-def convolve_rows_sparse(rows: np.ndarray, kernel: np.ndarray) -> np.ndarray:
+def convolve_rows_sparse(rows: np.ndarray, kernel: np.ndarray, nonzero: np.ndarray | None = None) -> np.ndarray:
     """Convolve each row of a sparse (M, N) array with a centred odd kernel (``'same'`` size, zeros beyond the ends).
 
     The target field of a revolution holds a few thousand non-zero cells in some 500 x 1024: spreading each
@@ -92,6 +92,8 @@ def convolve_rows_sparse(rows: np.ndarray, kernel: np.ndarray) -> np.ndarray:
         The array (mostly zeros).
     kernel : (L,) float
         Centred kernel, L odd.
+    nonzero : (Q,) int, optional
+        Flat indices of the cells that may be non-zero (found by a scan when not given).
 
     Returns
     -------
@@ -100,7 +102,7 @@ def convolve_rows_sparse(rows: np.ndarray, kernel: np.ndarray) -> np.ndarray:
     """
     m, n = rows.shape
     half = kernel.size // 2
-    flat = np.flatnonzero(rows)
+    flat = np.flatnonzero(rows) if nonzero is None else np.asarray(nonzero)
     cols = flat % n
     taps = np.arange(-half, half + 1)
     target = cols[:, None] + taps[None, :]  # (Q, L) column each tap lands on

@@ -202,7 +202,8 @@ class SeaClutter:
         # an inf poisons the FTC filter down the whole spoke); the cap keeps the rest of float32 finite
         mean_db[:, self.range_m <= h_max_m] = -np.inf
         np.minimum(mean_db, np.float32(MAX_CLUTTER_DB), out=mean_db)
-        return np.power(np.float32(10.0), mean_db * np.float32(0.1)), bh, cos_up, psi_c
+        mean_db *= np.float32(math.log(10.0) / 10.0)  # 10^(x/10) as exp(x ln10/10): float32 exp is vectorised
+        return np.exp(mean_db, out=mean_db), bh, cos_up, psi_c
 
     # ------------------------------------------------------------------ texture and the revolution
 
@@ -238,7 +239,8 @@ class SeaClutter:
         return np.maximum(texture, np.float32(TEXTURE_FLOOR), out=texture)
 
     def render(self, rev: int, t: np.ndarray, rot: np.ndarray, pos: np.ndarray, azimuth_deg: np.ndarray,
-               heading_deg: np.ndarray, antenna_h_m: np.ndarray, first_hit_m: np.ndarray | None):
+               heading_deg: np.ndarray, antenna_h_m: np.ndarray, first_hit_m: np.ndarray | None,
+               speckle: np.ndarray | None = None):
         """Sea clutter SNR of one revolution (K-distributed, zero in shadow and beyond the horizon) and its texture.
 
         Parameters
@@ -259,6 +261,9 @@ class SeaClutter:
             Antenna height above the sea per spoke, m.
         first_hit_m : (S,) float or None
             Range of the first object hit per spoke, m (inf: none); None leaves the shadow to :meth:`shadow`.
+        speckle : (S, N) float32, optional
+            Exponential (mean 1) speckle to multiply by; by default drawn from the stream ``radar.clutter.<rev>``
+            (and none at sea state 0).
 
         Returns
         -------
@@ -276,7 +281,9 @@ class SeaClutter:
             texture = self.texture_rows(pos[rows], bh, cos_up, psi_c, float(t[S // 2]))
             mean *= texture
         clutter = np.repeat(mean, self.sub, axis=0) if self.sub > 1 else mean
-        if texture is not None:
+        if speckle is not None:
+            clutter *= speckle
+        elif texture is not None:
             clutter *= stream(self.seed, f"radar.clutter.{rev}").standard_exponential((S, N), dtype=np.float32)
         if first_hit_m is not None:
             self.shadow(clutter, first_hit_m)

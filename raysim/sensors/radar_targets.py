@@ -284,7 +284,7 @@ class TargetEchoes:
         im = np.bincount(flat, weights=amp.imag, minlength=rows.size * N)
         field = np.empty(rows.size * N, np.complex64)
         field.real, field.imag = re, im
-        return rows, field.reshape(rows.size, N)
+        return rows, field.reshape(rows.size, N), np.unique(flat)
 
     def _add_skirt(self, power: np.ndarray, rows: np.ndarray, field: np.ndarray) -> None:
         """Add the incoherent range skirt (phase noise) of the strong echoes, through the two-way power pattern.
@@ -319,7 +319,7 @@ class TargetEchoes:
         pattern = r.az_power_pattern[(out[:, None] - spokes[None, :]) % S]  # (O, R') float32, >= 0
         power[out] += r.unblock(pattern @ skirt)
 
-    def _beam(self, rows: np.ndarray, field: np.ndarray) -> np.ndarray | None:
+    def _beam(self, rows: np.ndarray, field: np.ndarray, cells: np.ndarray) -> np.ndarray | None:
         """Range impulse response and two-way voltage beam over spokes, then power through the radar equation.
 
         Parameters
@@ -328,6 +328,8 @@ class TargetEchoes:
             Spokes of ``field``'s rows.
         field : (R, N) complex64
             Summed amplitudes per spoke and range sample, sqrt(m^2).
+        cells : (Q,) int64
+            Flat indices of ``field``'s cells holding an echo (the rest are zero).
 
         Returns
         -------
@@ -340,7 +342,7 @@ class TargetEchoes:
             return None
         power = np.zeros((S, N), np.float32)
         self._add_skirt(power, rows, field)
-        field = r.range_filter(field).astype(np.complex64)
+        field = r.range_filter(field, cells)
         # range samples whose strongest echo, even at the beam's peak, stays under INVISIBLE_SNR: left out
         cols = np.flatnonzero((field.real**2 + field.imag**2).max(axis=0) > INVISIBLE_SNR)
         if cols.size:
