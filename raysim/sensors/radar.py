@@ -65,8 +65,8 @@ DEG_PER_TURN = 360.0
 #: waterline still gets a fan) and, smaller, the height in the clutter tables (a grazing angle exists).
 FAN_MIN_HEIGHT_M = 0.1
 CLUTTER_MIN_HEIGHT_M = 0.05
-#: Rays are cast to this multiple of the range scale plus a margin, m: echoes from beyond the range
-#: scale still spread into its last bins through the range point-spread and the beam.
+#: Rays are cast to this multiple of the range scale plus a margin, m: objects just beyond the scale are still
+#: found (first hits for the shadow and the objects seen); echoes placed beyond the last sample are dropped.
 CAST_RANGE_FACTOR = 1.5
 CAST_RANGE_MARGIN_M = 10.0
 #: Floor of the summed power before taking dB (no log of 0).
@@ -93,7 +93,7 @@ class RadarParams:
     range_resolution_m: float = phys.RANGE_RESOLUTION_M
     polarisation: str = "HH"  # marine X-band radars are horizontally polarised
     # target scattering (REF 3.6): gain of the materials' rough-surface lobe (unverified engineering default);
-    # the specular part is facet physical optics, calibrated on the flat plate (no free gain)
+    # the specular part is physical optics over the ray tubes, calibrated on the flat plate (no free gain)
     diffuse_gain: float = 1.0
     # receiver (REF 3.10): video level v = floor((SNR_dB + STC - floor_db) / step_db), clipped 0..15.
     # floor 6.6 dB + one 3 dB step = 9.6 dB threshold: noise alone crosses it with Pfa ~ 1e-4 (REF 3 table)
@@ -213,7 +213,7 @@ class RadarRenderer:
         self.az_power_pattern = np.roll(np.abs(kernel[::-1]) ** 2, 1).astype(np.float32)
         self.range_kernel, self.range_skirt_kernel = range_kernel(p, self.dr, self.cfg.range_m, self.samples)
         self.range_skirt_blocks = block_kernel(self.range_skirt_kernel, SKIRT_BLOCK)
-        # clutter / rain cells use the -3 dB width as REF 3.7 does (R theta dR sec psi); the Gaussian
+        # clutter / rain cells use the -3 dB width as REF 3.7 does (R theta dR sec psi); a Gaussian
         # two-way pattern's equivalent width would be 0.753 theta3 (1.2 dB less): see docs/radar.md
         self.beam_eq_rad = math.radians(p.beam_az_deg)
         self.el_eq_rad = phys.two_way_equivalent_width_rad(p.beam_el_deg)
