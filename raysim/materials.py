@@ -140,6 +140,19 @@ CONCRETE_PERMITTIVITY = 6.0
 ASPHALT_PERMITTIVITY = 4.0
 # Rubber (carbon-black loaded fender rubber): about 3 (unverified).
 RUBBER_PERMITTIVITY = 3.0
+# Dry coastal rock (granite, gneiss): 5.5 (unverified). Dry rocks' permittivity from 0.5 to 18 GHz was
+# measured for 80 samples by Ulaby, Bengal, Dobson, East, Garvin and Evans, "Microwave dielectric
+# properties of dry rocks", IEEE TGRS 28(3), 1990, where it depends mostly on bulk density; the value
+# here is a typical figure for a granite of density about 2.6 g/cm^3, not read from that paper.
+ROCK_PERMITTIVITY = 5.5
+# Dry beach sand: 3.0 (unverified); dry soils are about 2.5-3.5 at X band (Hallikainen, Ulaby, Dobson,
+# El-Rayes and Wu, "Microwave dielectric behavior of wet soil - Part I", IEEE TGRS 23(1), 1985, whose
+# curves start from the dry soil's value; not read from it). Wet sand at the waterline is much higher.
+SAND_PERMITTIVITY = 3.0
+# Vegetation as a surface: an EFFECTIVE value of 3.0 (unverified) that, with a Lambertian lobe, stands
+# for a canopy's volume scattering; the leaves themselves are far higher (20-40 for fresh leaves, El-Rayes
+# and Ulaby, "Microwave dielectric spectrum of vegetation - Part I", IEEE TGRS 25(5), 1987; unverified).
+VEGETATION_PERMITTIVITY = 3.0
 
 # --- Radar specular-lobe half-power half-widths (engineering defaults, unverified) -----------
 # Smooth metal plates, sea surface: 5 deg (a 0.5 m facet at lambda = 3.19 cm has a
@@ -170,6 +183,11 @@ ICE_ROUGHNESS_M = 0.01
 SNOW_ROUGHNESS_M = 0.02
 ROUGH_ROUGHNESS_M = 0.003
 ASPHALT_ROUGHNESS_M = 0.005
+# Land: coastal rock and vegetation are fully rough at X band (rock faces: 2 cm; a canopy: 5 cm); sand is
+# smoother (2 mm ripples of grains; larger ripples and dunes are left to the mesh) (unverified).
+ROCK_ROUGHNESS_M = 0.02
+VEGETATION_ROUGHNESS_M = 0.05
+SAND_ROUGHNESS_M = 0.002
 
 
 def _dielectric(
@@ -262,6 +280,25 @@ MATERIALS: tuple[Material, ...] = (
         "sea", 0.02, SEA_WATER_PERMITTIVITY, SMOOTH_HALF_WIDTH_DEG, 0.0,
         "905 nm: 0.02, Fresnel reflectance of water, specular (docs/reference.md section 2); "
         "radar: Fresnel with sea-water er = 60 at X band (unverified).",
+    ),
+    # Land (issue 20); "concrete" above serves quays and piers.
+    _dielectric(
+        "rock", 0.30, ROCK_PERMITTIVITY, VERY_ROUGH_HALF_WIDTH_DEG, ROCK_ROUGHNESS_M,
+        "905 nm: 0.30 for weathered granite/gneiss (unverified; granite spectra of the ASTER spectral "
+        "library, Baldridge et al. 2009, are the place to check); radar: Fresnel with dry-rock er = 5.5 "
+        "(unverified; dry rocks measured by Ulaby et al., IEEE TGRS 28(3), 1990), 2 cm rough.",
+    ),
+    _dielectric(
+        "vegetation", 0.45, VEGETATION_PERMITTIVITY, STRUCTURE_HALF_WIDTH_DEG, VEGETATION_ROUGHNESS_M,
+        "905 nm: 0.45, green leaves' near-infrared plateau beyond the red edge (unverified; a canopy with "
+        "gaps and shadow is darker); radar: an effective er = 3.0 with a Lambertian lobe for the canopy's "
+        "volume scattering (unverified).",
+    ),
+    _dielectric(
+        "sand", 0.45, SAND_PERMITTIVITY, ROUGH_HALF_WIDTH_DEG, SAND_ROUGHNESS_M,
+        "905 nm: 0.45 for dry light quartz sand (unverified; USGS spectral library sand spectra are the "
+        "place to check); radar: Fresnel with dry-sand er = 3.0 (unverified; dry soils, Hallikainen et al., "
+        "IEEE TGRS 23(1), 1985).",
     ),
 )
 
