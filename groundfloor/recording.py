@@ -18,7 +18,7 @@ import numpy as np
 
 from groundfloor.frames import Mount
 
-__all__ = ["AIS_NMEA", "ArraySpec", "FORMAT", "FORMAT_VERSION", "LIDAR_PCAP", "LIDAR_SWEEP", "LIDAR_SWEEPS", "MANIFEST",
+__all__ = ["AIS_NMEA", "ArraySpec", "FORMAT", "FORMAT_VERSION", "LAND", "LIDAR_PCAP", "LIDAR_SWEEP", "LIDAR_SWEEPS", "MANIFEST",
            "OWNSHIP", "RADAR_SWEEP", "RADAR_SWEEPS", "SCENARIO", "SCHEMAS", "SWEEP_DIRS", "SweepSchema", "TRUTH",
            "LidarDescription", "RadarDescription", "RecordingDescription", "parse_start_time", "sweep_file_name"]
 
@@ -36,6 +36,10 @@ LIDAR_PCAP = "lidar/hdl32e.pcap"
 LIDAR_SWEEPS = "lidar/sweeps"
 RADAR_SWEEPS = "radar/sweeps"
 AIS_NMEA = "ais/ais.nmea"
+#: The recording's land (the chart's land mask, written when the scenario has land): a GeoJSON
+#: FeatureCollection (RFC 7946, WGS84 lon/lat) of Polygon/MultiPolygon features whose properties are
+#: ``id`` (the land object's id in manifest.json), ``name``, ``height_m`` and ``material``.
+LAND = "land.geojson"
 #: Sweep directory of each sensor, relative to the recording.
 SWEEP_DIRS = {"lidar": LIDAR_SWEEPS, "radar": RADAR_SWEEPS}
 

@@ -18,7 +18,7 @@ from typing import Callable
 import numpy as np
 from tqdm import tqdm
 
-from groundfloor.recording import FORMAT, FORMAT_VERSION, MANIFEST
+from groundfloor.recording import FORMAT, FORMAT_VERSION, LAND, MANIFEST
 from raysim import __version__, schema
 from raysim.pose import heading_deg_from_yaw
 from raysim.progress import bars as progress_bars
@@ -109,6 +109,8 @@ def write_truth(world: World, path: Path, progress: bool) -> int:
         for t in tqdm(list(_chunks(t_all, TRUTH_RATE_HZ)), desc="truth", unit="chunk", disable=not progress, leave=False):
             per_object = []
             for o in world.objects:
+                if o.kind == "land":  # land is in manifest.json, not in the epochs (docs/land.md)
+                    continue
                 poses = o.motion.poses(t)
                 lat, lon = world.frame.to_geodetic(poses.position_m[:, 0], poses.position_m[:, 1])
                 cog, sog = course_and_speed(o.motion.velocity_mps(t), poses.yaw_rad)
@@ -273,6 +275,11 @@ def render(scenario: Scenario, out_dir: Path, progress: bool | None = None, form
         ctx = RenderContext(world, staged.path, bars, wall_time_s=wall)
         with atomic_path(staged.path / "scenario.yaml") as tmp:
             tmp.write_text(scenario_to_yaml(scenario), encoding="utf-8")
+        if scenario.land:  # the chart's land mask, in the recording itself (groundfloor.recording.LAND)
+            from raysim.land.recording import write_land_geojson
+
+            land_ids = {o.name: o.object_id for o in world.objects if o.kind == "land"}
+            ctx.counts[LAND] = write_land_geojson(scenario, land_ids, staged.path / LAND)
         for name, write in (("truth", write_truth), ("ownship", write_ownship)):
             with stage(name, progress, f"{scenario.duration_s:g} s", bar=True) as step:
                 ctx.counts[f"{name}.jsonl"] = write(world, staged.path / f"{name}.jsonl", bars)

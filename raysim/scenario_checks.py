@@ -3,8 +3,9 @@
 :func:`validate` runs after :func:`raysim.schema.build` in :func:`raysim.scenario.load_scenario`:
 one own-ship motion, unique names and MMSIs, known materials, keys that apply to an object's
 kind, the run's times within what the outputs can stamp (:mod:`raysim.limits`), the scene's
-object count, the trajectory CSV's coverage, and every position within
-:data:`raysim.limits.MAX_DISTANCE_FROM_ORIGIN_M` of the origin. Each failure is one
+object count, the trajectory CSV's coverage, every position within
+:data:`raysim.limits.MAX_DISTANCE_FROM_ORIGIN_M` of the origin, and nothing on land
+(:mod:`raysim.land.checks`). Each failure is one
 :class:`raysim.errors.InputError` naming the key path.
 """
 
@@ -41,6 +42,10 @@ def validate(s: Scenario, ctx: Context) -> None:
     for i, ship in enumerate(s.ships):
         _check_ship(ctx, f"ships[{i}]", ship, names, mmsis)
     _check_distances(s, ctx)
+    if s.land:
+        from raysim.land.checks import check_land
+
+        check_land(s, ctx, names)
 
 
 def _check_object_count(s: Scenario, ctx: Context) -> None:

@@ -48,6 +48,7 @@ def _mmsi_check(value: int) -> str | None:
 
 
 _MESH_FILE = path_check("mesh file", MAX_MESH_FILE_BYTES)
+_LAND_FILE = path_check("GeoJSON file", MAX_MESH_FILE_BYTES)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -290,6 +291,20 @@ class Obstacle:
     material: str | None = param(None, doc="Material of a mesh file's faces", default_doc="concrete (mesh)")
 
 
+@dataclass(frozen=True, kw_only=True)
+class Land:
+    name: str = param(doc="Unique name among all objects")
+    file: Path = param(doc="GeoJSON file (RFC 7946) of Polygon/MultiPolygon land in WGS84 lon/lat, holes allowed, "
+                       "relative to the scenario file; a feature's height_m, material and slope_deg properties "
+                       "override this entry's (docs/land.md)", check=_LAND_FILE)
+    height_m: float = param(10.0, doc="Top height above the sea where a feature has no height_m property, m",
+                            gt=0, le=2000, check=SIZE_CHECK)
+    material: Literal["rock", "vegetation", "sand", "concrete"] = param(
+        "rock", doc="Material where a feature has no material property")
+    slope_deg: float | None = param(None, doc="Slope of the shore faces, deg from the horizontal (beaches, hills); "
+                                    "null = vertical", gt=0, le=90)
+
+
 def _periods_check(value) -> str | None:
     for i, (start, end) in enumerate(value):
         if not start < end:
@@ -365,6 +380,7 @@ class Scenario:
     tdm: Tdm = param(default_factory=Tdm, doc="Target detection module settings")
     obstacles: tuple[Obstacle, ...] = param((), doc="Fixed obstacles")
     ships: tuple[Ship, ...] = param((), doc="Other vessels")
+    land: tuple[Land, ...] = param((), doc="Land: coasts, islands, quays and piers from GeoJSON polygons (docs/land.md)")
     source_file: str = field(default="", compare=False, repr=False, init=False)
 
     def own_ship_start(self) -> LatLon:

@@ -1,7 +1,8 @@
 """The scenario turned into a world: objects with ids, meshes and motions.
 
 Truth ids are stable: the own ship is 0, then the obstacles in file order, then
-the ships in file order. Every object carries a :class:`raysim.meshes.BodyMesh`
+the ships in file order, then the land entries (kind ``land``: in manifest.json and in the sensors'
+object lists, not in truth.jsonl's epochs). Every object carries a :class:`raysim.meshes.BodyMesh`
 (body frame) and a :class:`raysim.motion.Motion`; :meth:`World.scene_objects`
 hands them to the ray engine.
 """
@@ -35,7 +36,7 @@ class WorldObject:
     object_id : int
         Truth id (own ship 0).
     name, kind : str
-        Kind is ``ownship``, ``ship``, ``iceberg``, ``buoy`` or ``mesh``.
+        Kind is ``ownship``, ``ship``, ``iceberg``, ``buoy``, ``mesh`` or ``land``.
     mesh : raysim.meshes.BodyMesh
         Geometry in the body frame.
     motion : raysim.motion.Motion
@@ -78,6 +79,7 @@ class World:
             objects.append(self._obstacle(len(objects), i, obstacle))
         for i, ship in enumerate(scenario.ships):
             objects.append(self._ship(len(objects), i, ship))
+        objects += self._land(len(objects))
         self.objects: tuple[WorldObject, ...] = tuple(objects)
         check_scene_triangles([(o.key_path, o.mesh.n_triangles) for o in objects], scenario.source_file or "scenario")
 
@@ -166,6 +168,17 @@ class World:
             mesh = self._load(o.mesh, o.material, where + ".mesh")
         length, beam, height = mesh.extents_above_water_m()
         return WorldObject(object_id, o.name, o.kind, mesh, motion, length, beam, height, None, where)
+
+    def _land(self, first_id: int) -> list[WorldObject]:
+        """The ``land`` entries, one object each (kind ``land``), standing at the origin in the local frame."""
+        from raysim.land.objects import land_bodies
+
+        objects = []
+        for k, body in enumerate(land_bodies(self.scenario, self.frame)):
+            length, beam, height = body.mesh.extents_above_water_m()
+            objects.append(WorldObject(first_id + k, body.name, "land", body.mesh, Stationary([0.0, 0.0, 0.0], 0.0),
+                                       length, beam, height, None, body.key_path))
+        return objects
 
     def _ship(self, object_id: int, index: int, ship) -> WorldObject:
         where = f"ships[{index}]"

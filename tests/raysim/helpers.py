@@ -70,3 +70,16 @@ def tiny_scenario(folder: Path) -> Path:
     path = folder / "tiny.yaml"
     path.write_text(yaml.safe_dump(data), encoding="utf-8")
     return path
+
+
+def land_file(tmp_path, name: str, corners_xy_m, height_m: float | None = None, material: str | None = None) -> str:
+    """A GeoJSON file of one polygon given by its corners (x east, y north of :data:`ORIGIN`, m); returns its name."""
+    import json
+
+    ring = [[latlon(x, y)[1], latlon(x, y)[0]] for x, y in corners_xy_m]
+    ring.append(ring[0])
+    properties = {k: v for k, v in (("height_m", height_m), ("material", material)) if v is not None}
+    feature = {"type": "Feature", "properties": properties, "geometry": {"type": "Polygon", "coordinates": [ring]}}
+    path = tmp_path / f"{name}.geojson"
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": [feature]}), encoding="utf-8")
+    return path.name

@@ -19,7 +19,7 @@ from raysim.materials import (
 
 REQUIRED_NAMES = {
     "steel_painted", "aluminium", "ice", "snow", "grp", "wood", "concrete", "asphalt",
-    "rubber", "retroreflector", "sea",
+    "rubber", "retroreflector", "sea", "rock", "vegetation", "sand",
 }
 
 
