@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Literal
 
 from raysim.input_files import MAX_CSV_FILE_BYTES, MAX_MESH_FILE_BYTES, path_check
+from raysim.land.geojson import MAX_LAND_FILE_BYTES
 from raysim.limits import RESOLVE_CHECK, SIZE_CHECK
 from raysim.schema import param
 
@@ -48,7 +49,7 @@ def _mmsi_check(value: int) -> str | None:
 
 
 _MESH_FILE = path_check("mesh file", MAX_MESH_FILE_BYTES)
-_LAND_FILE = path_check("GeoJSON file", MAX_MESH_FILE_BYTES)
+_LAND_FILE = path_check("GeoJSON file", MAX_LAND_FILE_BYTES)
 
 
 @dataclass(frozen=True, kw_only=True)
