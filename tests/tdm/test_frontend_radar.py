@@ -430,6 +430,9 @@ def test_a_single_ship_has_the_range_and_bearing_of_its_truth_within_the_resolut
         # beam nearer than the centre) within the 2.5 m range resolution and the 1.8 m sample spacing
         assert abs(bearing_error) < 0.15 * config.beam_az_deg
         assert -(truth["beam_m"] / 2 + 2 * config.range_resolution_m) < range_error < config.range_resolution_m
-        # the box lies along the ship, with about its length
+        # the box lies along the ship. Its length: since issue 19 the echo is coherent physical optics, and a
+        # flat hull side turned to the radar returns like a mirror, mostly from its middle (the ends' patches
+        # are off their specular lobe), so the plot's azimuth extent is mostly the beam's and the front end,
+        # taking the beam's smear off, recovers 12.6 m of the 30 m (0.5 to 1.5 lengths before issue 19)
         assert abs((det.orientation_deg[0] - (heading_deg + 90.0) + 90.0) % 180.0 - 90.0) < 10.0
-        assert 0.5 * length_m < det.length_m[0] < 1.5 * length_m and det.width_m[0] < det.length_m[0]
+        assert 0.3 * length_m < det.length_m[0] < 1.5 * length_m and det.width_m[0] < det.length_m[0]
