@@ -5,6 +5,7 @@ Truth (truth.jsonl) is used here only to check the front end, never by it.
 
 from __future__ import annotations
 
+import dataclasses
 import glob
 import math
 from pathlib import Path
@@ -421,7 +422,15 @@ def test_a_single_ship_has_the_range_and_bearing_of_its_truth_within_the_resolut
     assert len(sweeps) == 2
     for path in sweeps:
         det = radar_detections(dict(np.load(path)), track, mount, config)
-        assert len(det) == 1  # one plot, though it spans the last and the first spokes; no clutter plots
+        # one plot of the ship, though it spans the last and the first spokes; no clutter plots. Since issue 19
+        # the antenna has sidelobes: a plot beside it at the ship's range, far weaker and wider than the beam
+        # (beam fill >> 1), is its sidelobe arc, as real sets paint (the front end does not yet suppress arcs)
+        k = int(np.argmax(det.strength_db))
+        others = np.flatnonzero(np.arange(len(det)) != k)
+        assert np.all(np.abs(det.range_m[others] - det.range_m[k]) < 10.0)
+        assert np.all(det.strength_db[others] < det.strength_db[k] - 20.0) and np.all(det.beam_fill[others] > 3.0)
+        det = dataclasses.replace(det, **{f.name: getattr(det, f.name)[[k]] for f in dataclasses.fields(det)
+                                          if isinstance(getattr(det, f.name), np.ndarray)})
         own = track.position_m(det.time_s)[0, :2]
         d_true, d_plot = centre - own, det.position_m[0] - own
         bearing_error = (math.degrees(math.atan2(*d_plot) - math.atan2(*d_true)) + 180.0) % 360.0 - 180.0
