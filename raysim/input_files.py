@@ -25,6 +25,9 @@ __all__ = ["MAX_CSV_FILE_BYTES", "MAX_MESH_FILE_BYTES", "file_problem", "path_ch
 MAX_MESH_FILE_BYTES = 1_000_000_000
 #: Largest trajectory CSV read, bytes (a day at 100 Hz is about 500 MB).
 MAX_CSV_FILE_BYTES = 500_000_000
+#: Largest GeoJSON land file read, bytes (json holds it whole; OpenStreetMap's coast of Norway
+#: clipped to a 50 km scene is a few MB).
+MAX_LAND_FILE_BYTES = 200_000_000
 
 
 def size_text(n_bytes: int) -> str:

@@ -14,8 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Literal
 
-from raysim.input_files import MAX_CSV_FILE_BYTES, MAX_MESH_FILE_BYTES, path_check
-from raysim.land.geojson import MAX_LAND_FILE_BYTES
+from raysim.input_files import MAX_CSV_FILE_BYTES, MAX_LAND_FILE_BYTES, MAX_MESH_FILE_BYTES, path_check
 from raysim.limits import RESOLVE_CHECK, SIZE_CHECK
 from raysim.schema import param
 

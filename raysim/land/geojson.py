@@ -22,14 +22,11 @@ from shapely.geometry import LinearRing, Polygon
 from shapely.validation import explain_validity
 
 from raysim.errors import InputError
-from raysim.input_files import read_text_file
+from raysim.input_files import MAX_LAND_FILE_BYTES, read_text_file
 from raysim.land.mesh import LAND_MATERIALS
 
 __all__ = ["MAX_LAND_FILE_BYTES", "MAX_LAND_HEIGHT_M", "LandPolygon", "read_land_file"]
 
-#: Largest GeoJSON land file read, bytes (json holds it whole; OpenStreetMap's coast of Norway
-#: clipped to a 50 km scene is a few MB).
-MAX_LAND_FILE_BYTES = 200_000_000
 #: Highest land accepted, m above the sea (higher than any mountain; catches feet or millimetres).
 MAX_LAND_HEIGHT_M = 9_000.0
 
