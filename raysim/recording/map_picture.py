@@ -2,8 +2,10 @@
 
 Own-ship track (blue), other ships' tracks (orange, with their names), fixed objects as discs of
 their beam (bergs white, buoys yellow, other structures grey), tracks sampled every 1 s, a
-scale bar and the own ship's start and end. The top left says what it is and when (UTC start - end,
-duration), a key at the top right names every marker. Drawn from ``truth.jsonl``, read line by line.
+scale bar and the own ship's start and end. Land (the recording's ``land.geojson``) is filled in
+its material's colour under the tracks, clipped to the map's area, with its shoreline. The top
+left says what it is and when (UTC start - end, duration), a key at the top right names every
+marker. Drawn from ``truth.jsonl``, read line by line.
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
 from raysim.recording.jsonl import every, truth_epochs
+from raysim.recording.land_picture import LAND_COLOURS, LandOutline, clip_polygons, clip_shoreline, read_land
 from raysim.recording.staging import atomic_path
 
 __all__ = ["write_map"]
@@ -28,6 +31,7 @@ COLOURS = {"ownship": (60, 140, 255), "ship": (255, 140, 40), "iceberg": (235, 2
 SEA = (15, 40, 70)
 TEXT = (220, 220, 220)
 KEY_FILL = (8, 26, 48)
+COAST = (200, 200, 180)  # the shoreline drawn round the land's fill
 FONT_PX = 13  # Pillow's bundled font (the same glyphs everywhere: the pictures stay byte-identical)
 
 
@@ -54,13 +58,16 @@ def _time_span(start_time: dt.datetime | None, t0_s: float, t1_s: float) -> str:
     return f"{start:%Y-%m-%d %H:%M:%S} - {end.strftime(end_format)} UTC ({t1_s - t0_s:g} s)"
 
 
-def _key(draw: ImageDraw.ImageDraw, font) -> None:
-    """The key of the markers, top right: tracks with start and end circles, then the fixed objects."""
+def _key(draw: ImageDraw.ImageDraw, font, materials: tuple[str, ...] = ()) -> None:
+    """The key of the markers, top right: tracks with start and end circles, the fixed objects, the land."""
     rows = [("track", COLOURS["ownship"], "own ship's track (hollow: start, filled: end)"),
             ("track", COLOURS["ship"], "other ships' tracks, named at the end"),
             ("disc", COLOURS["iceberg"], "iceberg, a disc of its beam (drifting: a track)"),
             ("disc", COLOURS["buoy"], "buoy"),
             ("disc", COLOURS["mesh"], "other fixed object")]
+    if materials:  # one row: a swatch per material
+        swatches = [LAND_COLOURS.get(m, LAND_COLOURS["rock"]) for m in materials]
+        rows.append(("land", swatches, "land: " + ", ".join(materials)))
     width, line = 330, 18
     left, top = SIZE_PX - width - 10, 10
     draw.rectangle([left, top, SIZE_PX - 10, top + 8 + line * len(rows)], fill=KEY_FILL, outline=(90, 110, 140))
@@ -70,9 +77,28 @@ def _key(draw: ImageDraw.ImageDraw, font) -> None:
             draw.line([(left + 12, y), (left + 36, y)], fill=colour, width=2)
             draw.ellipse([left + 6, y - 4, left + 14, y + 4], outline=colour)
             draw.ellipse([left + 34, y - 4, left + 42, y + 4], fill=colour)
+        elif shape == "land":
+            step = 32 / len(colour)
+            for j, fill in enumerate(colour):
+                draw.rectangle([left + 8 + j * step, y - 5, left + 8 + (j + 1) * step, y + 5], fill=fill)
+            draw.rectangle([left + 8, y - 5, left + 40, y + 5], outline=COAST)
         else:
             draw.ellipse([left + 19, y - 5, left + 29, y + 5], fill=colour)
         draw.text((left + 50, y - 8), text, fill=TEXT, font=font)
+
+
+def _draw_land(draw: ImageDraw.ImageDraw, land: list[LandOutline], px,
+               area_m: tuple[float, float, float, float]) -> None:
+    """Fill the land clipped to the map's area (``area_m``: x0, y0, x1, y1 in metres), holes as sea; the shoreline."""
+    for outline in land:
+        fill = LAND_COLOURS.get(outline.material, LAND_COLOURS["rock"])
+        for part in clip_polygons(outline.polygon, *area_m):
+            draw.polygon(px(np.asarray(part.exterior.coords)), fill=fill)
+            for hole in part.interiors:
+                draw.polygon(px(np.asarray(hole.coords)), fill=SEA)
+    for outline in land:
+        for line in clip_shoreline(outline.polygon, *area_m):
+            draw.line(px(line), fill=COAST, width=1)
 
 
 def write_map(recording: Path, start_time: dt.datetime | None = None) -> None:
@@ -101,6 +127,9 @@ def write_map(recording: Path, start_time: dt.datetime | None = None) -> None:
     image = Image.new("RGB", (SIZE_PX, SIZE_PX), SEA)
     draw = ImageDraw.Draw(image)
     font = ImageFont.load_default(size=FONT_PX)
+    land = read_land(recording)
+    half_w_m, half_h_m = width_px / 2 / scale, height_px / 2 / scale
+    _draw_land(draw, land, px, (centre[0] - half_w_m, centre[1] - half_h_m, centre[0] + half_w_m, centre[1] + half_h_m))
     for track in sorted(tracks.values(), key=lambda t: t["kind"] == "ownship"):  # own ship on top
         colour = COLOURS.get(track["kind"], (150, 150, 150))
         points = px(track["xy"])
@@ -124,6 +153,6 @@ def write_map(recording: Path, start_time: dt.datetime | None = None) -> None:
     times = [t for track in tracks.values() for t in (track["t"][0], track["t"][-1])]
     draw.text((10, 10), "The whole run from above, north up (truth)", fill=TEXT, font=font)
     draw.text((10, 28), _time_span(start_time, min(times), max(times)), fill=TEXT, font=font)
-    _key(draw, font)
+    _key(draw, font, tuple(dict.fromkeys(o.material for o in land)))
     with atomic_path(recording / "map.png") as tmp:
         image.save(tmp, format="PNG")
