@@ -26,6 +26,7 @@ Modules, one job each:
 - :mod:`~tdm.recording.sweeps`: the LiDAR and radar sweep arrays against their schema;
 - :mod:`~tdm.recording.sweep_files`: the numbered sweep files and their order in time;
 - :mod:`~tdm.recording.pcap_times`: PCAP packets inside the run and in time order;
+- :mod:`~tdm.recording.land`: ``land.geojson``, the recording's land (the TDM's chart, :mod:`tdm.land`);
 - :mod:`~tdm.recording.summary`: ``tdm info``, every file checked as far as headers go.
 
 The PCAP's own structure (magic, link type, record lengths) is checked by :mod:`tdm.pcap`, the

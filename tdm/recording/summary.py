@@ -4,7 +4,8 @@ Reads what ``tdm run`` reads, as far as it can be checked without decoding the s
 ``manifest.json``, ``scenario.yaml`` and ``ownship.jsonl`` in full; every sweep file's listing and
 array headers (names, dtypes, shapes, lengths: :func:`tdm.recording.sweeps.read_sweep_layout`, no
 array loaded); the PCAP's global header (whenever the file is there: ``tdm run`` reads it with
-``--lidar-source pcap`` or without NPZ sweeps); that ``ais/ais.nmea`` is a readable file. The same
+``--lidar-source pcap`` or without NPZ sweeps); that ``ais/ais.nmea`` is a readable file;
+``land.geojson`` in full (:mod:`~tdm.recording.land`). The same
 defects give the same errors and warnings as in ``tdm run``; defects only the data shows (a NaN in
 a sweep, packets out of time, bad NMEA lines, sweeps out of order, an empty sweep) are left to
 ``tdm run``.
@@ -20,6 +21,7 @@ from groundfloor.recording import AIS_NMEA, LIDAR_PCAP
 from tdm.detections import ReadStats
 from tdm.pcap import check_pcap_header
 from tdm.recording.files import directory_present, is_present, regular_file
+from tdm.recording.land import read_land
 from tdm.recording.manifest import read_manifest
 from tdm.recording.npz import Unreadable
 from tdm.recording.ownship import read_ownship
@@ -47,6 +49,8 @@ class RecordingSummary:
         Size of ``lidar/hdl32e.pcap`` (None: absent).
     ais_lines : int or None
         Lines of ``ais/ais.nmea`` (None: absent).
+    land_polygons : int or None
+        Polygons of ``land.geojson`` (None: absent, no land).
     warnings : dict of str to int
         Counted warnings (keys as ``tdm run``'s).
     """
@@ -57,6 +61,7 @@ class RecordingSummary:
     sweep_files: dict[str, int] = field(default_factory=dict)
     pcap_bytes: int | None = None
     ais_lines: int | None = None
+    land_polygons: int | None = None
     warnings: dict[str, int] = field(default_factory=dict)
 
     def lines(self, recording: Path) -> list[str]:
@@ -71,6 +76,8 @@ class RecordingSummary:
         if self.ais_lines is not None:
             parts.append(f"AIS {self.ais_lines} lines")
         out.append(f"  sensor data: {', '.join(parts) or 'none'}")
+        if self.land_polygons is not None:
+            out.append(f"  land: {self.land_polygons} polygons (land.geojson, the TDM's land mask)")
         return out
 
 
@@ -116,5 +123,7 @@ def summarise(recording: Path) -> RecordingSummary:
         regular_file(ais)
         with open(ais, "rb") as handle:  # in blocks: memory flat whatever the file's size
             summary.ais_lines = sum(block.count(b"\n") for block in iter(lambda: handle.read(1 << 20), b""))
+    land = read_land(rec)  # read and checked in full, as tdm run and tdm evaluate read it
+    summary.land_polygons = None if land is None else len(land.polygons)
     summary.warnings = dict(stats.warnings)
     return summary
