@@ -6,6 +6,10 @@ front ends (in a pool of worker processes: scans are independent), and fed to on
 sensor in the order they end. At every output epoch ``k / update_rate_hz`` the fuser takes the
 confirmed tracks of all sensors and the detected targets are written.
 
+The recording's land (``land.geojson``) is the TDM's chart (:mod:`tdm.land`): detections on it are
+dropped in the front ends' workers, and a target or sensor track whose estimate lies on it at an
+output epoch is not written at that epoch (its track goes on).
+
 Every file is read through :mod:`tdm.recording` (docs/formats.md, "Reading a recording: warnings
 and errors"). Problems a real logger leaves and that leave the rest readable (a missing or
 unreadable sweep file, a cut PCAP, bad NMEA lines, a cut last line of ownship.jsonl) are counted as
@@ -27,10 +31,12 @@ from typing import Callable, Iterable
 
 import numpy as np
 
+from tdm import ekf
 from tdm.detections import ReadStats
 from tdm.errors import RecordingError
 from tdm.fusion import Fuser, FusionConfig
 from tdm.io import read_manifest, read_scenario
+from tdm.land import LandMask
 from tdm.messages import jsonl_writer, target_record
 from tdm.recording.scenario import MAX_UPDATE_RATE_HZ
 from tdm.run_config import FUSION_RULES, LIDAR_SOURCES, TdmConfig
@@ -89,6 +95,11 @@ class _Tracking:
         self.scans = {"lidar": 0, "radar": 0, "ais": len(stream.reports)}
         self.n_lines = 0
         self.target_ids: set[int] = set()
+        self.chart = None if stream.land is None else LandMask(stream.land, self.ownship.frame, 0.0)
+
+    def on_land(self, x: np.ndarray) -> bool:
+        """Whether the state ``x`` (:mod:`tdm.ekf`) lies on the chart's land (no margin): not reported."""
+        return self.chart is not None and bool(self.chart.contains(x[ekf.E:ekf.E + 1], x[ekf.N:ekf.N + 1])[0])
 
     def process(self, t_end: float, sensor: str, payload) -> None:
         """One scan's detections (at its end time, s) or one AIS report into its tracker."""
@@ -107,6 +118,8 @@ class _Tracking:
         by_sensor["ais"] = self.ais.confirmed_tracks()
         for estimate in self.fuser.step(t_out, by_sensor):
             tgt = estimate.target
+            if self.on_land(estimate.x):
+                continue
             write_target(target_record(t_out, tgt.target_id, tgt.descriptor, estimate.x, estimate.p,
                                        estimate.sources, frame, tgt.mmsi))
             self.target_ids.add(tgt.target_id)
@@ -115,6 +128,8 @@ class _Tracking:
         for sensor, tracks in by_sensor.items():
             for tr in tracks:
                 x, p = tr.predicted(t_out)
+                if self.on_land(x):
+                    continue
                 write_track(target_record(t_out, tr.track_id, descriptors.get((sensor, tr.track_id), "unknown"),
                                           x, p, [sensor], frame, tr.mmsi, sensor=sensor))
 

@@ -18,7 +18,9 @@ from tdm.frontend.ais import read_ais
 from tdm.frontend.lidar import LidarFrontEndConfig
 from tdm.frontend.radar import RadarFrontEndConfig
 from tdm.io import read_manifest, read_ownship, read_scenario
+from tdm.land import DETECTION_MARGIN_M, LandMask
 from tdm.recording.files import directory_present, is_present, regular_file
+from tdm.recording.land import read_land
 from tdm.recording.manifest import start_time_unix_s as _start_time_unix_s
 from tdm.recording.description import RecordingDescription, describe
 from tdm.recording.sweep_files import list_sweeps, sweep_window_s
@@ -117,6 +119,9 @@ class DetectionStream:
         ownship.jsonl columns.
     reports : list of AisReport
     static : dict of int to AisStatic
+    land : tdm.recording.land.ChartLand or None
+        The recording's land (``land.geojson``, :func:`tdm.recording.land.read_land`); the front
+        ends' detections on it (within :data:`tdm.land.DETECTION_MARGIN_M`) are dropped.
     description : RecordingDescription
         The recording's typed description (:func:`tdm.recording.description.describe`): its
         duration, the sensors' periods, ranges and mounts, read once for the whole run.
@@ -133,8 +138,10 @@ class DetectionStream:
         self.description = describe(rec, manifest, scenario)
         lidar_cfg = LidarFrontEndConfig.from_scenario(scenario)
         radar_cfg = RadarFrontEndConfig.from_scenario(scenario)
+        self.land = read_land(rec)
+        detection_mask = None if self.land is None else LandMask(self.land, self.ownship.frame, DETECTION_MARGIN_M)
         self._initargs = (self.ownship, self.description.lidar.mount, lidar_cfg, self.description.radar.mount,
-                          radar_cfg, _sweep_limits(self.description))
+                          radar_cfg, _sweep_limits(self.description), detection_mask)
         self._jobs = _scan_jobs(rec, config, manifest, self.description, stats)
         ais_path = rec / "ais" / "ais.nmea"
         self.reports, self.static = [], {}

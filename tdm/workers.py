@@ -1,7 +1,8 @@
 """The front ends' worker pool of ``tdm run``: scans in, detections out, in time order.
 
 Scans are independent, so their front ends (:func:`tdm.frontend.lidar.lidar_detections`,
-:func:`tdm.frontend.radar.radar_detections`) run in a pool of worker processes. Each worker gets
+:func:`tdm.frontend.radar.radar_detections`, then the chart's land mask, :mod:`tdm.land`) run in a
+pool of worker processes. Each worker gets
 the own-ship track, the mounts and the front ends' settings once (:func:`_init_worker`); a job is a
 sweep file to read (checked in the worker) or a sweep already read (the PCAP's). Results come back
 in submission order and pass a reorder buffer that puts them in exact end-time order
@@ -21,6 +22,7 @@ import numpy as np
 from tdm.detections import Detections, ReadStats
 from tdm.frontend.lidar import lidar_detections
 from tdm.frontend.radar import radar_detections
+from tdm.land import drop_on_land
 from tdm.recording.npz import Unreadable
 from tdm.recording.sweep_files import SweepOrder
 from tdm.recording.sweeps import SCHEMAS, read_sweep, unreadable_warning
@@ -44,9 +46,9 @@ _WORKER: dict = {}
 FrontendResult = tuple[str, float, float, Detections | None, str | None, Path | None]
 
 
-def _init_worker(track, lidar_mount, lidar_cfg, radar_mount, radar_cfg, limits=None) -> None:
+def _init_worker(track, lidar_mount, lidar_cfg, radar_mount, radar_cfg, limits=None, land=None) -> None:
     _WORKER.update(track=track, lidar=(lidar_mount, lidar_cfg), radar=(radar_mount, radar_cfg),
-                   limits=limits or {})
+                   limits=limits or {}, land=land)
 
 
 def _read_sweep_file(sensor: str, path: Path) -> dict | str:
@@ -76,8 +78,12 @@ def _frontend(job: tuple[str, object]) -> FrontendResult:
     if times.size == 0:
         return sensor, -1.0, -1.0, None, f"{sensor}: empty sweeps", path
     mount, cfg = _WORKER[sensor]
-    func = lidar_detections if sensor == "lidar" else radar_detections
-    dets = func(sweep, _WORKER["track"], mount, cfg)
+    land = _WORKER.get("land")  # the chart's land mask (tdm.land), or None
+    if sensor == "lidar":
+        dets = lidar_detections(sweep, _WORKER["track"], mount, cfg, land)
+    else:
+        dets = radar_detections(sweep, _WORKER["track"], mount, cfg)
+    dets = drop_on_land(dets, land)
     return sensor, float(np.min(times)), float(np.max(times)), dets, None, path
 
 

@@ -15,7 +15,8 @@ Steps (all vectorised; the only Python loop is over ring offsets):
    rolling-shutter distortion from own-ship yaw, roll, pitch, heave and speed.
 4. **Sea.** Points below ``min_height_m`` in ENU are sea and foam: the sea surface is the
    plane z = 0 of the ENU frame (wave motion shows up in the own ship's pose, which step 3
-   removes), so returns from foam and wakes lie within centimetres of z = 0.
+   removes), so returns from foam and wakes lie within centimetres of z = 0. **Land**: with the
+   recording's chart (``land``, :mod:`tdm.land`), points on land or within its margin go too.
 5. **Voxels.** Points are binned into vertical columns ("pillars", 2D voxels) of
    ``voxel_m`` on the horizontal plane (``np.unique`` of integer keys, with a count per
    voxel); each voxel is represented by the mean of its points.
@@ -98,6 +99,7 @@ from tdm.detections import Detections
 from tdm.frames import Mount, OwnshipTrack
 from tdm.frontend.lidar_config import (HDL32E_FIRING_CYCLE_S, LINK_WINDOW_CYCLES, LidarFrontEndConfig,
                                        lidar_mount_from_scenario)
+from tdm.land import LandMask
 
 __all__ = ["HDL32E_FIRING_CYCLE_S", "LINK_WINDOW_CYCLES", "LidarFrontEndConfig", "lidar_clusters", "lidar_detections",
            "lidar_mount_from_scenario"]
@@ -196,7 +198,7 @@ def _range_image_links(ring: np.ndarray, points_m: np.ndarray, range_m: np.ndarr
 
 
 def lidar_detections(sweep: dict[str, np.ndarray], track: OwnshipTrack, mount: Mount,
-                     config: LidarFrontEndConfig | None = None) -> Detections:
+                     config: LidarFrontEndConfig | None = None, land: LandMask | None = None) -> Detections:
     """Clusters of one LiDAR revolution as detections in ENU (module docstring for the method).
 
     Parameters
@@ -212,6 +214,8 @@ def lidar_detections(sweep: dict[str, np.ndarray], track: OwnshipTrack, mount: M
         The LiDAR's mounting on the own ship.
     config : LidarFrontEndConfig, optional
         Settings; default ``LidarFrontEndConfig()``.
+    land : tdm.land.LandMask, optional
+        The chart's land mask: points on it are dropped before clustering (none without).
 
     Returns
     -------
@@ -219,16 +223,17 @@ def lidar_detections(sweep: dict[str, np.ndarray], track: OwnshipTrack, mount: M
         ``sensor="lidar"``, one row per cluster (see :class:`tdm.detections.Detections`);
         ``scan_time_s`` is the sweep's first point time.
     """
-    return lidar_clusters(sweep, track, mount, config)[0]
+    return lidar_clusters(sweep, track, mount, config, land)[0]
 
 
 def lidar_clusters(sweep: dict[str, np.ndarray], track: OwnshipTrack, mount: Mount,
-                   config: LidarFrontEndConfig | None = None) -> tuple[Detections, np.ndarray, np.ndarray]:
+                   config: LidarFrontEndConfig | None = None,
+                   land: LandMask | None = None) -> tuple[Detections, np.ndarray, np.ndarray]:
     """:func:`lidar_detections` plus which sweep points make up each detection.
 
     Parameters
     ----------
-    sweep, track, mount, config
+    sweep, track, mount, config, land
         As for :func:`lidar_detections`.
 
     Returns
@@ -250,8 +255,10 @@ def lidar_clusters(sweep: dict[str, np.ndarray], track: OwnshipTrack, mount: Mou
     # 3. deskew: every point with the pose at its own time
     enu = _sensor_to_enu(track, sensor_points, t if config.deskew else np.full_like(t, scan_time_s), mount,
                          config.deskew_step_s)
-    # 4. sea and foam
+    # 4. sea and foam (and the chart's land)
     above = enu[:, 2] >= config.min_height_m
+    if land is not None:  # the chart's land (tdm.land): its points make no cluster
+        above &= ~land.contains(enu[:, 0], enu[:, 1])
     if not above.any():
         return _nothing(scan_time_s)
     enu, sensor_points, t, range_m, idx = enu[above], sensor_points[above], t[above], range_m[above], idx[above]
