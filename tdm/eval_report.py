@@ -84,6 +84,7 @@ _TABLE_ROWS = (
     ("max detection latency [s]", "detection_latency_max_s", 1),
     ("false targets / min", "false_targets_per_min", 2),
     ("false reports / min", "false_reports_per_min", 2),
+    ("targets on land", "targets_on_land", 0),
     ("ID switches", "id_switches", 0),
     ("NEES mean (ideal 2)", "nees", 2),
     ("NEES in 95 % interval", "nees_fraction_in_95", 3),

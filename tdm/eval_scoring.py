@@ -68,8 +68,13 @@ def subset(reports: dict[str, np.ndarray], mask: np.ndarray) -> dict[str, np.nda
 
 
 def _assign(truth: TruthAtEpochs, visible: np.ndarray, rep_pos: np.ndarray, report_epoch: np.ndarray,
-            c_m: float, p: float, dont_care: np.ndarray | None) -> dict:
-    """Per epoch: the assignment, OSPA and GOSPA terms; the matched pairs (epoch, object, report, distance)."""
+            c_m: float, p: float, dont_care: np.ndarray | None, on_land: np.ndarray | None = None) -> dict:
+    """Per epoch: the assignment, OSPA and GOSPA terms; the matched pairs (epoch, object, report, distance).
+
+    A report ``on_land`` (N,) is at least the cut-off from every object: never matched nor ignored,
+    a false report (and a cardinality error in OSPA and GOSPA).
+    """
+    land = np.zeros(report_epoch.size, dtype=bool) if on_land is None else np.asarray(on_land, dtype=bool)
     E = visible.shape[0]
     kept = np.flatnonzero(report_epoch >= 0)
     order = kept[np.argsort(report_epoch[kept], kind="stable")]
@@ -84,12 +89,13 @@ def _assign(truth: TruthAtEpochs, visible: np.ndarray, rep_pos: np.ndarray, repo
         ks = np.flatnonzero(visible[e])
         hs = np.flatnonzero(dont_care[e] & ~visible[e]) if dont_care is not None else np.zeros(0, np.int64)
         if hs.size and rows.size:  # reports of hidden objects leave the set (one assignment over both)
-            rj, cj = assign_distances(distance_matrix(truth_pos[e, np.r_[ks, hs]], rep_pos[rows]), c_m, p)
+            rj, cj = assign_distances(_off_land(distance_matrix(truth_pos[e, np.r_[ks, hs]], rep_pos[rows]),
+                                                land[rows], c_m), c_m, p)
             drop = cj[rj >= ks.size]
             is_ignored[rows[drop]] = True
             rows = np.delete(rows, drop)
             n_rep_e[e] = rows.size
-        d = distance_matrix(truth_pos[e, ks], rep_pos[rows])
+        d = _off_land(distance_matrix(truth_pos[e, ks], rep_pos[rows]), land[rows], c_m)
         per_epoch["ospa"][e] = ospa_distances(d, c_m, p)
         g = gospa_distances(d, c_m, p, GOSPA_ALPHA)
         per_epoch["gospa"][e], per_epoch["gospa_loc"][e] = g["total"], g["localisation"]
@@ -104,6 +110,13 @@ def _assign(truth: TruthAtEpochs, visible: np.ndarray, rep_pos: np.ndarray, repo
     pd = np.concatenate(pairs_d) if pairs_d else np.zeros(0)
     return {"per_epoch": per_epoch, "n_rep_e": n_rep_e, "kept": kept, "is_ignored": is_ignored,
             "pe": pe, "pk": pk, "pr": pr, "pd": pd, "truth_pos": truth_pos}
+
+
+def _off_land(d_m: np.ndarray, on_land: np.ndarray, c_m: float) -> np.ndarray:
+    """The distances ``d_m`` (objects x reports) with those of the reports ``on_land`` raised to the cut-off."""
+    if on_land.any():
+        d_m[:, on_land] = np.maximum(d_m[:, on_land], c_m)
+    return d_m
 
 
 def _pair_errors(truth: TruthAtEpochs, reports: dict[str, np.ndarray], rep_pos: np.ndarray, a: dict,
@@ -200,6 +213,16 @@ def _false(reports: dict[str, np.ndarray], report_epoch: np.ndarray, a: dict, du
             "target_ids": int(uids.size)}
 
 
+def _on_land(reports: dict[str, np.ndarray], report_epoch: np.ndarray, on_land: np.ndarray | None) -> dict:
+    """``targets_on_land`` (ids reported on land at least once, within the truth's span) and ``reports_on_land``."""
+    if on_land is None:
+        return {"targets_on_land": 0, "reports_on_land": 0, "target_ids_on_land": []}
+    land = np.asarray(on_land, dtype=bool) & (report_epoch >= 0)
+    ids = np.unique(reports["target_id"][land])
+    return {"targets_on_land": int(ids.size), "reports_on_land": int(np.count_nonzero(land)),
+            "target_ids_on_land": [int(x) for x in ids]}
+
+
 def score(truth: TruthAtEpochs, visible: np.ndarray, reports: dict[str, np.ndarray], report_epoch: np.ndarray,
           c_m: float, p: float, duration_s: float, lidar_range_m: float, with_series: bool,
           dont_care: np.ndarray | None = None) -> dict:
@@ -228,6 +251,9 @@ def score(truth: TruthAtEpochs, visible: np.ndarray, reports: dict[str, np.ndarr
         never don't care); reports that the assignment gives to them are ignored (neither matched
         nor false).
 
+    ``reports["on_land"]`` (N,) bool, when present, marks the reports on the recording's land:
+    never matched or ignored (false), and counted (``targets_on_land``, ``reports_on_land``).
+
     Returns
     -------
     dict
@@ -235,7 +261,8 @@ def score(truth: TruthAtEpochs, visible: np.ndarray, reports: dict[str, np.ndarr
     """
     E = visible.shape[0]
     rep_pos = np.stack([reports["east_m"], reports["north_m"]], axis=-1)  # (N, 2)
-    a = _assign(truth, visible, rep_pos, report_epoch, c_m, p, dont_care)
+    on_land = reports.get("on_land")
+    a = _assign(truth, visible, rep_pos, report_epoch, c_m, p, dont_care, on_land)
     per_epoch, pd = a["per_epoch"], a["pd"]
     n_visible = int(visible.sum())
     out = {name: float(np.mean(per_epoch[key])) if E else math.nan
@@ -245,6 +272,7 @@ def score(truth: TruthAtEpochs, visible: np.ndarray, reports: dict[str, np.ndarr
     out["detection_rate"] = pd.size / n_visible if n_visible else math.nan
     out.update(_per_object(truth, visible, reports, a))
     out.update(_false(reports, report_epoch, a, duration_s))
+    out.update(_on_land(reports, report_epoch, on_land))
     out.update({"epochs": E, "in_range_pairs": n_visible, "matched_pairs": int(pd.size)})
     if with_series:
         t_s, pe, pk, pr = truth.t_s, a["pe"], a["pk"], a["pr"]

@@ -63,6 +63,11 @@ Hidden objects ("don't care")
     objects together, and those given to hidden objects are ignored (``ignored_reports``),
     the MOT/KITTI "don't care" convention. A tracker that coasts through an occlusion is
     not punished for it.
+Land
+    A report whose position lies on the recording's land (``land.geojson``, the polygons
+    themselves, boundary included; no file: no land) is never matched and never ignored: it is
+    false even next to an object. ``targets_on_land`` counts the target ids reported on land at
+    least once, ``reports_on_land`` the (target, epoch) reports on land (both also per sensor).
 False targets
     A target id is false when it is matched at fewer than half of the epochs it is
     reported at (ignored reports not counted); ``false_targets_per_min`` = number of false
@@ -117,7 +122,9 @@ from tdm.eval_truth import EPOCH_DECIMALS, TRUTH_TIME_TOLERANCE_S, TruthAtEpochs
     truth_span
 from tdm.eval_visibility import RADAR_VISIBLE_MIN_SPOKES, VISIBLE_WINDOW_S, visibility
 from tdm.io import read_manifest, read_scenario
+from tdm.land import on_chart_land
 from tdm.metrics import DEFAULT_CUTOFF_M, DEFAULT_ORDER_P, GOSPA_ALPHA
+from tdm.recording.land import read_land
 
 __all__ = ["evaluate", "write_metrics", "format_table", "read_truth_enu", "read_reports",
            "TruthAtEpochs", "DEFINITIONS",
@@ -153,6 +160,9 @@ DEFINITIONS = {
     "false_targets_per_min": "target ids matched at fewer than half of their reported epochs, per minute of "
                              "manifest duration",
     "false_reports_per_min": "unmatched (target, epoch) reports per minute, ignored ones not counted",
+    "targets_on_land": "target ids reported on the recording's land (land.geojson, boundary included) at least "
+                      "once; a report on land is never matched nor ignored: it is false even near an object "
+                      "(reports_on_land: such (target, epoch) reports)",
     "ignored_reports": "reports assigned to objects within a sensor's range but hidden from every sensor (ray "
                        "truth): neither matched nor false",
     "id_switches": "total over objects of changes of matched target id between consecutive matched epochs",
@@ -175,6 +185,10 @@ def _read_inputs(recording: Path, warnings: dict[str, int]) -> dict:
     targets = read_report_columns(targets_path)
     tracks_path = recording / "tdm" / "sensor_tracks.jsonl"
     tracks = read_report_columns(tracks_path, with_sensor=True) if tracks_path.is_file() else None
+    land = read_land(recording)
+    for columns in (targets, tracks):
+        if columns is not None:
+            columns["on_land"] = on_chart_land(land, columns["latitude"], columns["longitude"])
 
     truth_path = recording / "truth.jsonl"
     span_s = truth_span(truth_path)
@@ -194,6 +208,7 @@ def _read_inputs(recording: Path, warnings: dict[str, int]) -> dict:
             "targets": reports_in_frame(targets, frame),
             "tracks": None if tracks is None else reports_in_frame(tracks, frame),
             "visible_by_sensor": visible_by_sensor, "hidden_by_sensor": hidden_by_sensor,
+            "land_polygons": 0 if land is None else len(land.polygons),
             "duration_s": params.duration_s if params.duration_s is not None else t1_s - t0_s}
 
 
@@ -253,7 +268,8 @@ def evaluate(recording: Path, c_m: float = DEFAULT_CUTOFF_M, p: float = DEFAULT_
                              "update_rate_hz": inputs["params"].rate_hz, "duration_s": duration_s,
                              "moving_sog_mps": MOVING_SOG_MPS, "lidar_visible_window_s": VISIBLE_WINDOW_S,
                              "nees_95_interval": list(NEES_95_INTERVAL),
-                             "frame_origin_lat_lon_deg": [frame.lat0_deg, frame.lon0_deg]}
+                             "frame_origin_lat_lon_deg": [frame.lat0_deg, frame.lon0_deg],
+                             "land_polygons": inputs["land_polygons"]}
     metrics["definitions"] = dict(DEFINITIONS)
     if warnings:
         metrics["warnings"] = dict(sorted(warnings.items()))
