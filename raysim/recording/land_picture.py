@@ -18,7 +18,8 @@ from shapely.geometry import LineString, Polygon, box, shape
 from groundfloor.frames import LocalFrame
 from groundfloor.recording import LAND
 
-__all__ = ["LAND_COLOURS", "LandOutline", "clip_polygons", "clip_shoreline", "read_land", "recording_frame"]
+__all__ = ["LAND_COLOURS", "LandOutline", "clip_polygons", "clip_shoreline", "land_extent", "read_land",
+           "recording_frame"]
 
 #: Fill colours of land on ``map.png`` by material (RGB): earth tones for rock, vegetation and sand,
 #: a light grey-brown for concrete quays and piers.
@@ -113,3 +114,19 @@ def clip_shoreline(polygon: Polygon, x0_m: float, y0_m: float, x1_m: float, y1_m
             if isinstance(part, LineString) and not part.is_empty:
                 lines.append(np.asarray(part.coords))
     return lines
+
+
+def land_extent(land: list[LandOutline], lo_m: np.ndarray, hi_m: np.ndarray,
+                reach_m: float) -> tuple[np.ndarray, np.ndarray]:
+    """The box (lo, hi) of x, y metres grown to hold the land within ``reach_m`` of it.
+
+    A map framed on the tracks then shows the shore they pass, and not the whole of a large coast.
+    """
+    near = box(lo_m[0] - reach_m, lo_m[1] - reach_m, hi_m[0] + reach_m, hi_m[1] + reach_m)
+    lo, hi = np.array(lo_m, dtype=float), np.array(hi_m, dtype=float)
+    for outline in land:
+        part = outline.polygon.intersection(near)
+        if not part.is_empty:
+            x0, y0, x1, y1 = part.bounds
+            lo, hi = np.minimum(lo, (x0, y0)), np.maximum(hi, (x1, y1))
+    return lo, hi

@@ -3,9 +3,9 @@
 Own-ship track (blue), other ships' tracks (orange, with their names), fixed objects as discs of
 their beam (bergs white, buoys yellow, other structures grey), tracks sampled every 1 s, a
 scale bar and the own ship's start and end. Land (the recording's ``land.geojson``) is filled in
-its material's colour under the tracks, clipped to the map's area, with its shoreline. The top
-left says what it is and when (UTC start - end, duration), a key at the top right names every
-marker. Drawn from ``truth.jsonl``, read line by line.
+its material's colour under the tracks, with its shoreline; the map frames the tracks and the land
+within :data:`LAND_REACH_M` of them. The top left says what it is and when (UTC start - end,
+duration), a key at the top right names every marker. Drawn from ``truth.jsonl``, read line by line.
 """
 
 from __future__ import annotations
@@ -18,7 +18,8 @@ import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
 from raysim.recording.jsonl import every, truth_epochs
-from raysim.recording.land_picture import LAND_COLOURS, LandOutline, clip_polygons, clip_shoreline, read_land
+from raysim.recording.land_picture import (LAND_COLOURS, LandOutline, clip_polygons, clip_shoreline, land_extent,
+                                          read_land)
 from raysim.recording.staging import atomic_path
 
 __all__ = ["write_map"]
@@ -32,6 +33,7 @@ SEA = (15, 40, 70)
 TEXT = (220, 220, 220)
 KEY_FILL = (8, 26, 48)
 COAST = (200, 200, 180)  # the shoreline drawn round the land's fill
+LAND_REACH_M = 150.0  # the map frames the tracks and the land within this distance of their box
 FONT_PX = 13  # Pillow's bundled font (the same glyphs everywhere: the pictures stay byte-identical)
 
 
@@ -114,7 +116,8 @@ def write_map(recording: Path, start_time: dt.datetime | None = None) -> None:
     recording = Path(recording)
     tracks = _read_tracks(recording / "truth.jsonl")
     xy = np.concatenate([t["xy"] for t in tracks.values()])
-    lo, hi = xy.min(axis=0) - 50.0, xy.max(axis=0) + 50.0
+    land = read_land(recording)
+    lo, hi = land_extent(land, xy.min(axis=0) - 50.0, xy.max(axis=0) + 50.0, LAND_REACH_M)
     width_px, height_px = SIZE_PX - 2 * MARGIN_PX, SIZE_PX - TOP_PX - MARGIN_PX  # the map's area below the band
     scale = min(width_px / float(hi[0] - lo[0]), height_px / float(hi[1] - lo[1]))  # px per metre
     centre = (lo + hi) / 2.0
@@ -127,7 +130,6 @@ def write_map(recording: Path, start_time: dt.datetime | None = None) -> None:
     image = Image.new("RGB", (SIZE_PX, SIZE_PX), SEA)
     draw = ImageDraw.Draw(image)
     font = ImageFont.load_default(size=FONT_PX)
-    land = read_land(recording)
     half_w_m, half_h_m = width_px / 2 / scale, height_px / 2 / scale
     _draw_land(draw, land, px, (centre[0] - half_w_m, centre[1] - half_h_m, centre[0] + half_w_m, centre[1] + half_h_m))
     for track in sorted(tracks.values(), key=lambda t: t["kind"] == "ownship"):  # own ship on top

@@ -32,6 +32,7 @@ def square(x0: float, y0: float, x1: float, y1: float) -> list[tuple[float, floa
 def recording(tmp_path, land_rings=None, material: str = "rock"):
     """A recording with an own ship going north from (-400, -400) to (-400, 400) m past a buoy at (400, 400) m,
     the origin and (optionally) land."""
+    tmp_path.mkdir(parents=True, exist_ok=True)
     (tmp_path / "scenario.yaml").write_text(f"name: t\norigin:\n  lat: {LAT0}\n  lon: {LON0}\n", encoding="utf-8")
     lines = []
     for k, t in enumerate(np.arange(0.0, 9.0)):
@@ -112,3 +113,16 @@ def test_the_birds_eye_view_outlines_the_shoreline_about_the_sensor(tmp_path):
     assert abs(cols_px.min() - 480) <= 1 and abs(cols_px.max() - 560) <= 1
     assert abs(rows_px.min() - 360) <= 1 and abs(rows_px.max() - 440) <= 1
     assert shore[362:439, 482:559].sum() == 0  # an outline, not a fill
+
+
+def test_the_map_frames_land_near_the_tracks_and_not_land_far_from_them(tmp_path):
+    # the objects' box with its 50 m margin is -450..450 m; land within 150 m of it is framed
+    near = recording(tmp_path / "near", [ring(square(500, 0, 560, 60))])
+    far = recording(tmp_path / "far", [ring(square(1500, 0, 1560, 60))])
+    for rec in (near, far):
+        write_map(rec, START)
+    in_map = land_mask(near / "map.png", LAND_COLOURS["rock"])
+    in_map = in_map[TOP_PX:SIZE_PX - MARGIN_PX, MARGIN_PX:SIZE_PX - MARGIN_PX]
+    scale = (SIZE_PX - 2 * MARGIN_PX) / 1010.0  # px per metre: the box grown to x = 560 m is 1010 m wide
+    assert in_map.sum() > 0.8 * 60 * 60 * scale ** 2  # the whole island (its shoreline's pixels are drawn over it)
+    assert not land_mask(far / "map.png", LAND_COLOURS["rock"])[TOP_PX:].any()
