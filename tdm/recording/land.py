@@ -86,9 +86,11 @@ def read_land(recording: Path) -> ChartLand | None:
 
 
 def _feature_collection(root: object, path: Path) -> list[Polygon]:
-    if not isinstance(root, dict) or root.get("type") != "FeatureCollection":
-        shown = root.get("type") if isinstance(root, dict) else values.describe(root)
-        raise RecordingError(str(path), "type", f"must be a GeoJSON FeatureCollection, not {shown!r}")
+    if not isinstance(root, dict):
+        raise RecordingError(str(path), "(top level)",
+                             f"must be a GeoJSON FeatureCollection object, not {values.describe(root)}")
+    if root.get("type") != "FeatureCollection":
+        raise RecordingError(str(path), "type", f"must be a GeoJSON FeatureCollection, not {root.get('type')!r}")
     features = root.get("features")
     if not isinstance(features, list):
         raise RecordingError(str(path), "features", f"must be an array of Features, not {values.describe(features)}")
@@ -98,7 +100,7 @@ def _feature_collection(root: object, path: Path) -> list[Polygon]:
 def _feature(feature: object, path: Path, where: str) -> list[Polygon]:
     if not isinstance(feature, dict) or feature.get("type") != "Feature":
         raise RecordingError(str(path), f"{where}.type", "not a GeoJSON Feature (its \"type\" must be \"Feature\")")
-    if not isinstance(feature.get("properties") or {}, dict):
+    if not isinstance(feature.get("properties", {}), (dict, type(None))):
         raise RecordingError(str(path), f"{where}.properties", "must be an object or null")
     geometry = feature.get("geometry")
     where = f"{where}.geometry"
