@@ -74,6 +74,7 @@ class World:
         self.scenario = scenario
         self.frame = LocalFrame(scenario.origin.lat, scenario.origin.lon)
         self._mesh_cache: dict = {}
+        self._scene_objects: list | None = None
         objects = [self._own_ship()]
         for i, obstacle in enumerate(scenario.obstacles):
             objects.append(self._obstacle(len(objects), i, obstacle))
@@ -91,7 +92,16 @@ class World:
         """The objects as the ray engine wants them (:class:`raysim.scene.SceneObject`)."""
         from raysim.scene import SceneObject
 
-        return [SceneObject(o.object_id, o.mesh.vertices_m, o.mesh.faces, o.mesh.face_material, o.motion) for o in self.objects]
+        from raysim.land.objects import land_tiles
+
+        if self._scene_objects is not None:
+            return list(self._scene_objects)
+        out = []
+        for o in self.objects:
+            for mesh in land_tiles(o.mesh) if o.kind == "land" else (o.mesh,):  # land: in tiles (the engine's culling)
+                out.append(SceneObject(o.object_id, mesh.vertices_m, mesh.faces, mesh.face_material, o.motion))
+        self._scene_objects = out
+        return list(out)
 
     # ------------------------------------------------------------------ builders
 

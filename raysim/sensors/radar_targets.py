@@ -50,6 +50,9 @@ VELOCITY_STEP_S = 0.05
 INVISIBLE_SNR = 0.01
 #: Threads of the beam's FFTs over spokes.
 FFT_WORKERS = 2
+#: Up to this many spokes with a strong echo the range skirt goes over the spokes by a matrix product on the
+#: main lobe's rows; beyond, by an FFT over all spokes (a coast paints on every spoke).
+SKIRT_MATMUL_MAX_SPOKES = 64
 #: Roughness relief: wavevectors of the body-fixed random phase field (count, wavelength m, phase scale).
 RELIEF_WAVES = 8
 RELIEF_WAVELENGTH_M = 0.3
@@ -103,6 +106,7 @@ class TargetEchoes:
         self.relief_phase = rng.uniform(0.0, 2.0 * math.pi, RELIEF_WAVES)
         self.snr_amp = np.sqrt(phys.snr(1.0, renderer.r64, **renderer.snr_kw))  # (N,) sqrt(SNR) per sqrt(m^2)
         self._az_kernel_f = renderer.az_kernel_f.astype(np.complex64)[:, None]  # (S, 1) voltage pattern spectrum
+        self._az_power_pattern_f = np.fft.rfft(renderer.az_power_pattern)[:, None]  # (S // 2 + 1, 1) power pattern
         skirt = renderer.range_skirt_kernel
         self._skirt_peak = 0.0 if skirt is None else float(np.max(skirt))
 
@@ -315,9 +319,17 @@ class TargetEchoes:
         S = r.spokes
         reach = np.flatnonzero(r.az_power_pattern * skirt.max() > INVISIBLE_SNR)  # spoke offsets that count
         spokes = rows[strong_rows]
-        out = np.unique((spokes[:, None] + reach[None, :]) % S)
-        pattern = r.az_power_pattern[(out[:, None] - spokes[None, :]) % S]  # (O, R') float32, >= 0
-        power[out] += r.unblock(pattern @ skirt)
+        if spokes.size <= SKIRT_MATMUL_MAX_SPOKES:  # a few strong spokes: the main lobe's rows by a matrix product
+            out = np.unique((spokes[:, None] + reach[None, :]) % S)
+            pattern = r.az_power_pattern[(out[:, None] - spokes[None, :]) % S]  # (O, R') float32, >= 0
+            power[out] += r.unblock(pattern @ skirt)
+            return
+        # many (a coast on every spoke): one circular convolution over all spokes, on the blocks
+        full = np.zeros((S, skirt.shape[1]), np.float32)
+        full[spokes] = skirt
+        spread = scipy.fft.irfft(scipy.fft.rfft(full, axis=0, workers=FFT_WORKERS) * self._az_power_pattern_f,
+                                 n=S, axis=0, workers=FFT_WORKERS)
+        power += r.unblock(np.maximum(spread, 0.0).astype(np.float32))
 
     def _beam(self, rows: np.ndarray, field: np.ndarray, cells: np.ndarray) -> np.ndarray | None:
         """Range impulse response and two-way voltage beam over spokes, then power through the radar equation.
