@@ -33,6 +33,25 @@ from raysim.motion import Stationary
 from raysim.scene import NO_HIT, SEA_ID, Hits, Scene, SceneObject, intersect_sea
 
 
+#: Margin of the own ship's bounding box for the rays' box test, m (float32 meshes, rounding).
+BOX_MARGIN_M = 0.01
+
+
+def _meets_box(origins_m: np.ndarray, directions: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """(N,) bool: which rays (origins (N, 3) m, directions (N, 3)) meet the box [lo, hi] ahead of their origin.
+
+    The slab test, vectorised; a direction component of 0 gives +-inf slab distances (the ray meets the slab
+    everywhere or nowhere).
+    """
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv = 1.0 / np.asarray(directions, dtype=float)
+        t1 = (lo[None, :] - origins_m) * inv
+        t2 = (hi[None, :] - origins_m) * inv
+    t_near = np.nanmax(np.minimum(t1, t2), axis=1)
+    t_far = np.nanmin(np.maximum(t1, t2), axis=1)
+    return t_far >= np.maximum(t_near, 0.0)
+
+
 class CarrierScene:
     """Ray engine for sensors carried by the own ship (truth id ``carrier_id``).
 
@@ -63,6 +82,8 @@ class CarrierScene:
             body = carrier[0]
             self.carrier = Scene([SceneObject(body.object_id, body.vertices_m, body.faces, body.face_material,
                                               Stationary([0.0, 0.0, 0.0]))], sea=False)
+            vertices = np.asarray(body.vertices_m, dtype=float)
+            self._box = (vertices.min(axis=0) - BOX_MARGIN_M, vertices.max(axis=0) + BOX_MARGIN_M)
 
     def carrier_hits(self, origins_body_m: np.ndarray, directions_body: np.ndarray, max_range_m=np.inf) -> Hits:
         """Hits of body-frame rays on the own ship alone.
@@ -82,7 +103,17 @@ class CarrierScene:
         n = origins_body_m.shape[0]
         if self.carrier is None:
             return Hits.empty(n)
-        return self.carrier.cast(origins_body_m, directions_body, np.zeros(n), max_range_m=max_range_m)
+        near = np.flatnonzero(_meets_box(origins_body_m, directions_body, *self._box))
+        if near.size == n:
+            return self.carrier.cast(origins_body_m, directions_body, np.zeros(n), max_range_m=max_range_m)
+        hits = Hits.empty(n)  # only rays that meet the own ship's bounding box can hit it (a radar's rarely do)
+        if near.size:
+            limit = max_range_m if np.ndim(max_range_m) == 0 else np.asarray(max_range_m)[near]
+            some = self.carrier.cast(np.asarray(origins_body_m)[near], np.asarray(directions_body)[near],
+                                     np.zeros(near.size), max_range_m=limit)
+            for name in ("range_m", "object_id", "normal", "material", "primitive"):
+                getattr(hits, name)[near] = getattr(some, name)
+        return hits
 
     def cast(self, origins_world_m: np.ndarray, directions_world: np.ndarray, times_s: np.ndarray,
              origins_body_m: np.ndarray | None = None, directions_body: np.ndarray | None = None,
