@@ -243,6 +243,17 @@ def _write_derived(ctx: RenderContext, scenario: Scenario, formats: tuple[str, .
         wall["pointclouds"] = step.elapsed_s
 
 
+def _write_scenario_files(ctx: RenderContext, scenario: Scenario) -> None:
+    """The resolved ``scenario.yaml`` and, with land, the recording's chart ``land.geojson`` (groundfloor.recording.LAND)."""
+    with atomic_path(ctx.out_dir / "scenario.yaml") as tmp:
+        tmp.write_text(scenario_to_yaml(scenario), encoding="utf-8")
+    if scenario.land:
+        from raysim.land.recording import write_land_geojson
+
+        land_ids = {o.name: o.object_id for o in ctx.world.objects if o.kind == "land"}
+        ctx.counts[LAND] = write_land_geojson(scenario, land_ids, ctx.out_dir / LAND)
+
+
 def render(scenario: Scenario, out_dir: Path, progress: bool | None = None, formats: tuple[str, ...] = (),
            after_sensors: Callable[[Path], dict[str, int]] | None = None) -> RenderResult:
     """Render ``scenario`` into ``out_dir``; all or nothing.
@@ -273,13 +284,7 @@ def render(scenario: Scenario, out_dir: Path, progress: bool | None = None, form
     enabled = scenario.sensors.enabled_names()
     with StagedDirectory(Path(out_dir)) as staged:
         ctx = RenderContext(world, staged.path, bars, wall_time_s=wall)
-        with atomic_path(staged.path / "scenario.yaml") as tmp:
-            tmp.write_text(scenario_to_yaml(scenario), encoding="utf-8")
-        if scenario.land:  # the chart's land mask, in the recording itself (groundfloor.recording.LAND)
-            from raysim.land.recording import write_land_geojson
-
-            land_ids = {o.name: o.object_id for o in world.objects if o.kind == "land"}
-            ctx.counts[LAND] = write_land_geojson(scenario, land_ids, staged.path / LAND)
+        _write_scenario_files(ctx, scenario)
         for name, write in (("truth", write_truth), ("ownship", write_ownship)):
             with stage(name, progress, f"{scenario.duration_s:g} s", bar=True) as step:
                 ctx.counts[f"{name}.jsonl"] = write(world, staged.path / f"{name}.jsonl", bars)

@@ -16,8 +16,8 @@ from raysim.scenario_format import LatLon, Scenario
 from raysim.schema import Context
 
 
-def land_polygons(s: Scenario) -> list[tuple[str, LandPolygon]]:
-    """Every land polygon of the scenario with the key path of its ``land`` entry (``land[0]``), file order.
+def land_polygons(s: Scenario) -> list[tuple[int, LandPolygon]]:
+    """Every land polygon of the scenario with the index of its ``land`` entry, in file order.
 
     Raises
     ------
@@ -27,7 +27,7 @@ def land_polygons(s: Scenario) -> list[tuple[str, LandPolygon]]:
     out = []
     for i, entry in enumerate(s.land):
         for polygon in read_land_file(entry.file, entry.height_m, entry.material):
-            out.append((f"land[{i}]", polygon))
+            out.append((i, polygon))
     return out
 
 
@@ -54,8 +54,8 @@ def check_land(s: Scenario, ctx: Context, names: dict[str, str]) -> None:
 
     def on_land(geometry) -> str | None:
         for k in tree.query(geometry, predicate="intersects"):
-            where, polygon = polygons[int(k)]
-            entry = s.land[int(where[5:-1])]
+            index, polygon = polygons[int(k)]
+            entry = s.land[index]
             return f"{entry.name!r} ({entry.file.name} {polygon.where or 'polygon'})"
         return None
 

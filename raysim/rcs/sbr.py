@@ -135,6 +135,30 @@ def _cast(scene, o: np.ndarray, d: np.ndarray, t_far: np.ndarray, lo, hi) -> tup
     return t, normal
 
 
+def _launch(origins_m: np.ndarray, direction: np.ndarray, field: np.ndarray, axes: tuple[np.ndarray, np.ndarray],
+            sea: bool):
+    """The tubes' start: origins (N, 3), directions, complex fields, grid axes (N, 3) each and path lengths (N,).
+
+    With the sea, a tube that begins under water starts further back along its line (its path < 0 there), and one
+    that cannot reach the air is dropped.
+    """
+    n = len(origins_m)
+    o = origins_m.copy()
+    d = np.tile(direction, (n, 1))
+    e = np.tile(np.asarray(field, dtype=complex), (n, 1))
+    au, av = np.tile(axes[0], (n, 1)), np.tile(axes[1], (n, 1))
+    path = np.zeros(n)
+    if sea:
+        below = o[:, 2] < 0.0
+        if direction[2] < 0.0:
+            back = (-o[below, 2] + EPSILON_M) / -direction[2]
+            o[below] -= back[:, None] * direction
+            path[below] -= back
+        keep = o[:, 2] >= 0.0
+        o, d, e, au, av, path = o[keep], d[keep], e[keep], au[keep], av[keep], path[keep]
+    return o, d, e, au, av, path
+
+
 def trace(
     vertices_m: np.ndarray, faces: np.ndarray, origins_m: np.ndarray, direction: np.ndarray,
     field: np.ndarray, axes: tuple[np.ndarray, np.ndarray], gamma: float, n_bounces: int,
@@ -176,20 +200,7 @@ def trace(
     scene.add_triangles(o3d.core.Tensor(vertices_m.astype(np.float32)),
                         o3d.core.Tensor(np.asarray(faces, dtype=np.uint32)))
     lo, hi = vertices_m.min(axis=0) - BOX_PAD_M, vertices_m.max(axis=0) + BOX_PAD_M
-    n = len(origins_m)
-    o = origins_m.copy()
-    d = np.tile(direction, (n, 1))
-    e = np.tile(np.asarray(field, dtype=complex), (n, 1))
-    au, av = np.tile(axes[0], (n, 1)), np.tile(axes[1], (n, 1))
-    path = np.zeros(n)
-    if sea is not None:  # start rays that begin under water further back along their line (path < 0 there)
-        below = o[:, 2] < 0.0
-        if direction[2] < 0.0:
-            back = (-o[below, 2] + EPSILON_M) / -direction[2]
-            o[below] -= back[:, None] * direction
-            path[below] -= back
-        keep = o[:, 2] >= 0.0
-        o, d, e, au, av, path = o[keep], d[keep], e[keep], au[keep], av[keep], path[keep]
+    o, d, e, au, av, path = _launch(origins_m, direction, field, axes, sea is not None)
     out: list[MeshHits] = []
     z_hat = np.array([0.0, 0.0, 1.0])
     for _ in range(n_bounces):
