@@ -65,7 +65,7 @@ def steady_state(scenario, duration_s: float) -> tuple[float, float, RadarRender
 
 def raw_embree_rays_per_s(renderer: RadarRenderer, rev: int, repeats: int) -> tuple[float, int]:
     """Raw Open3D casting of one revolution's world rays against the frozen scene at its middle."""
-    t, *_, o_w, d_w, _, _ = renderer.rays(rev)
+    t, *_, o_w, d_w = renderer.rays(rev)
     t_s = float(t[t.size // 2])
     rays = np.concatenate([o_w, d_w], axis=1).astype(np.float32)
     return frozen_scene_rays_per_s(renderer.world.objects, rays, t_s, repeats), rays.shape[0]

@@ -152,6 +152,8 @@ class CarrierScene:
             sea = intersect_sea(origins_world_m[idx, 2], directions_world[idx, 2])
             wet = sea < own.range_m[idx]
             on_carrier[idx[wet]] = False
+        if not on_carrier.any():  # nothing on the own ship (a radar's usual case): the world's hits as they are
+            return self.world.cast(origins_world_m, directions_world, times_s, max_range_m=max_range_m), on_carrier
         free = np.flatnonzero(~on_carrier)
         hits = Hits(own.range_m.copy(), own.object_id.copy(), own.normal.copy(), own.material.copy(), own.primitive.copy())
         if free.size:

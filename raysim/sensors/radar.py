@@ -239,6 +239,14 @@ class RadarRenderer:
         self.n_revolutions = int(math.floor(s.duration_s / self.rev_s + 1e-9))
         self.targets = TargetEchoes(self)
         self.rev_wall_s: list[float] = []
+        # the spokes' azimuths and the rays' sensor-frame directions are the same every revolution, and so are the
+        # own-ship hits (body frame, fixed mount): done once here, not per revolution
+        self.max_range_m = self.cfg.range_m * CAST_RANGE_FACTOR + CAST_RANGE_MARGIN_M
+        self.azimuth_deg = np.arange(self.spokes) * (DEG_PER_TURN / self.spokes)
+        self.d_sensor = self._sensor_directions(self.azimuth_deg)  # (S, K, 3)
+        d_b = self.d_sensor.reshape(self.spokes * self.k, 3) @ self.mount_rotation.T
+        o_b = np.broadcast_to(self.mount_translation, d_b.shape)
+        self.own_hits = scene.carrier_hits(o_b, d_b, self.max_range_m)
 
     # ------------------------------------------------------------------ geometry
 
@@ -252,7 +260,7 @@ class RadarRenderer:
 
         The skirt is a smooth Lorentzian pedestal 65 dB under its echo (docs/radar.md section 5): it changes by
         under 2 dB over a block, so it is formed on blocks (echo powers summed per block, the kernel averaged over
-        each block offset) and repeated over the block's samples (:meth:`unblock`). None if the model has none.
+        each block offset) and added to each of the block's samples (:meth:`add_blocks`). None if the model has none.
         """
         if self.range_skirt_blocks is None:
             return None
@@ -265,9 +273,24 @@ class RadarRenderer:
         out = fftconvolve(per_block, self.range_skirt_blocks[None, :], mode="full", axes=1)[:, half: half + blocks]
         return np.maximum(out, 0.0).astype(np.float32)
 
-    def unblock(self, blocks: np.ndarray) -> np.ndarray:
-        """(M, N) samples of (M, B) values per SKIRT_BLOCK-sample block (:meth:`range_skirt`)."""
-        return np.repeat(blocks, SKIRT_BLOCK, axis=1)[:, : self.samples]
+    def add_blocks(self, power: np.ndarray, blocks: np.ndarray, rows: np.ndarray | None = None) -> None:
+        """Add (M, B) values per SKIRT_BLOCK-sample block (:meth:`range_skirt`) to each of their block's samples.
+
+        Parameters
+        ----------
+        power : (S, N) float32
+            Added to in place: all its rows (``rows`` None, M = S) or the rows ``rows`` (M,).
+        blocks : (M, B) float32
+            One value per block of SKIRT_BLOCK range samples (the last block may be partial).
+        """
+        n = self.samples
+        target = power if rows is None else power[rows]  # C-contiguous either way
+        if n % SKIRT_BLOCK == 0:  # a (M, B, SKIRT_BLOCK) view: each block's value broadcast, no (M, N) repeat formed
+            target.reshape(target.shape[0], n // SKIRT_BLOCK, SKIRT_BLOCK)[...] += blocks[:, :, None]
+        else:
+            target += np.repeat(blocks, SKIRT_BLOCK, axis=1)[:, :n]
+        if rows is not None:
+            power[rows] = target
 
     def _poses(self, t: np.ndarray):
         poses = self.world.own_ship.motion.poses(t)
@@ -285,18 +308,14 @@ class RadarRenderer:
         return d.reshape(azimuth_deg.size, self.k, 3)
 
     def rays(self, rev: int):
-        """The rays of revolution ``rev``: spoke times, poses and the world/body ray arrays."""
+        """The rays of revolution ``rev``: spoke times (S,) s, azimuths (S,) deg, poses, sensor-to-world rotations
+        (S, 3, 3), antenna positions (S, 3) m, and the (S K, 3) world ray origins (m) and directions."""
         S, K = self.spokes, self.k
-        idx = np.arange(S)
-        t = (rev * S + idx) / (S * self.cfg.rpm / SECONDS_PER_MINUTE)
-        azimuth = idx * (DEG_PER_TURN / S)
+        t = (rev * S + np.arange(S)) / (S * self.cfg.rpm / SECONDS_PER_MINUTE)
         poses, rot, pos = self._poses(t)
-        d_s = self._sensor_directions(azimuth)  # (S, K, 3)
-        d_w = (d_s @ rot.transpose(0, 2, 1)).reshape(S * K, 3)  # each spoke's rows times its rotation's transpose
+        d_w = (self.d_sensor @ rot.transpose(0, 2, 1)).reshape(S * K, 3)  # each spoke's rows times its rotation's transpose
         o_w = np.repeat(pos, K, axis=0)
-        d_b = d_s.reshape(S * K, 3) @ self.mount_rotation.T
-        o_b = np.broadcast_to(self.mount_translation, (S * K, 3))
-        return t, azimuth, poses, rot, pos, o_w, d_w, o_b, d_b
+        return t, self.azimuth_deg, poses, rot, pos, o_w, d_w
 
     def _clutter_mean_db_table(self, antenna_h: np.ndarray) -> np.ndarray:
         """(H, N) mean sea clutter, dB re. noise, at the level boresight (:meth:`SeaClutter.mean_db_table`)."""
@@ -313,13 +332,14 @@ class RadarRenderer:
         so the bytes do not depend on the threads' timing.
         """
         K = self.k
-        t, azimuth, poses, rot, pos, o_w, d_w, o_b, d_b = self.rays(rev)
+        t, azimuth, poses, rot, pos, o_w, d_w = self.rays(rev)
         heading = heading_deg_from_yaw(poses.yaw_rad)
         antenna_h = np.maximum(pos[:, 2], CLUTTER_MIN_HEIGHT_M)
-        max_range = self.cfg.range_m * CAST_RANGE_FACTOR + CAST_RANGE_MARGIN_M
+        max_range = self.max_range_m
         with ThreadPoolExecutor(max_workers=1, thread_name_prefix="radar-clutter") as pool:
             sea = pool.submit(self._sea_and_noise, rev, t, rot, pos, azimuth, heading, antenna_h)
-            hits, on_carrier = self.scene.cast(o_w, d_w, np.repeat(t, K), o_b, d_b, max_range_m=max_range)
+            hits, on_carrier = self.scene.cast(o_w, d_w, np.repeat(t, K), max_range_m=max_range,
+                                               carrier_hits=self.own_hits)
             targets, first_hit, seen = self.targets.render(hits, on_carrier, t, o_w, d_w, antenna_h, rot, azimuth,
                                                            max_range)
             clutter, texture, noise = sea.result()

@@ -322,14 +322,14 @@ class TargetEchoes:
         if spokes.size <= SKIRT_MATMUL_MAX_SPOKES:  # a few strong spokes: the main lobe's rows by a matrix product
             out = np.unique((spokes[:, None] + reach[None, :]) % S)
             pattern = r.az_power_pattern[(out[:, None] - spokes[None, :]) % S]  # (O, R') float32, >= 0
-            power[out] += r.unblock(pattern @ skirt)
+            r.add_blocks(power, pattern @ skirt, out)
             return
         # many (a coast on every spoke): one circular convolution over all spokes, on the blocks
         full = np.zeros((S, skirt.shape[1]), np.float32)
         full[spokes] = skirt
         spread = scipy.fft.irfft(scipy.fft.rfft(full, axis=0, workers=FFT_WORKERS) * self._az_power_pattern_f,
                                  n=S, axis=0, workers=FFT_WORKERS)
-        power += r.unblock(np.maximum(spread, 0.0).astype(np.float32))
+        r.add_blocks(power, np.maximum(spread, 0.0).astype(np.float32))
 
     def _beam(self, rows: np.ndarray, field: np.ndarray, cells: np.ndarray) -> np.ndarray | None:
         """Range impulse response and two-way voltage beam over spokes, then power through the radar equation.

@@ -10,7 +10,7 @@ from raysim.cli import main
 from raysim.materials import material_index
 from raysim.scenario import load_scenario
 from raysim.sensors.carrier import CarrierScene
-from raysim.sensors.radar import RadarRenderer
+from raysim.sensors.radar import SKIRT_BLOCK, RadarRenderer
 from raysim.world import World
 from tests.raysim.helpers import box_file, latlon, scenario
 
@@ -248,8 +248,8 @@ def test_a_15_m_berg_at_the_range_scale_is_hit_by_several_rays_each_way(tmp_path
     berg = {"name": "berg", "kind": "iceberg", "position": latlon(1800.0 * np.sin(0.3), 1800.0 * np.cos(0.3)),
             "radius_m": 7.5, "height_m": 6, "seed": 2}
     r, _ = radar_world(tmp_path, obstacles=[berg], environment={"sea_state": 0, "wind_speed_mps": 0}, name="far")
-    t, _, _, _, _, o_w, d_w, o_b, d_b = r.rays(0)
-    hits, on_carrier = r.scene.cast(o_w, d_w, np.repeat(t, r.k), o_b, d_b, max_range_m=3000.0)
+    t, _, _, _, _, o_w, d_w = r.rays(0)
+    hits, on_carrier = r.scene.cast(o_w, d_w, np.repeat(t, r.k), max_range_m=3000.0, carrier_hits=r.own_hits)
     on_berg = np.flatnonzero(hits.object_id == r.world.objects[-1].object_id)
     azimuth_rays = np.unique(on_berg // r.el_rad.size)  # spoke x sub-ray
     elevation_rays = np.unique(on_berg % r.el_rad.size)
@@ -509,3 +509,20 @@ def test_scenario_keys_set_the_radar_model(tmp_path):
     path.write_text(yaml.safe_dump(data))
     assert main(["render", str(path), "-o", str(tmp_path / "out")]) == 2
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("samples", [512, 509])
+def test_block_values_are_added_to_every_sample_of_their_block(tmp_path, samples):
+    renderer, _ = radar_world(tmp_path, environment={"sea_state": 0, "wind_speed_mps": 0})
+    renderer.samples = samples  # add_blocks reads only the sample count
+    rng = np.random.default_rng(3)
+    n_blocks = -(-samples // SKIRT_BLOCK)
+    blocks = rng.random((4, n_blocks), dtype=np.float32)
+    expected = np.repeat(blocks, SKIRT_BLOCK, axis=1)[:, :samples]  # block b covers samples b*8 .. b*8+7
+    power = np.ones((6, samples), np.float32)
+    renderer.add_blocks(power, blocks, np.array([5, 0, 2, 3]))
+    assert np.array_equal(power[[5, 0, 2, 3]], 1.0 + expected)
+    assert np.array_equal(power[[1, 4]], np.ones((2, samples), np.float32))
+    whole = np.zeros((4, samples), np.float32)
+    renderer.add_blocks(whole, blocks)
+    assert np.array_equal(whole, expected)
