@@ -105,6 +105,31 @@ class _Candidates:
                    np.full((f, e), -1, dtype=np.int32), np.zeros((f, e), dtype=np.uint8))
 
 
+@dataclass
+class LidarChunk:
+    """One chunk of a LiDAR render (:meth:`LidarRenderer.chunks`).
+
+    Attributes
+    ----------
+    time_s : (C,) float64
+        Start of each firing cycle, s since the scenario start.
+    firings : Firings
+        What each firing measured.
+    payloads : (P, 1206) uint8
+        The chunk's data packets.
+    sent_s : (P,) float64
+        When each data packet leaves the sensor (the end of its last cycle), s.
+    position_times_s : list of float
+        Times of the position packets due in the chunk, s.
+    """
+
+    time_s: np.ndarray
+    firings: Firings
+    payloads: np.ndarray
+    sent_s: np.ndarray
+    position_times_s: list
+
+
 class LidarRenderer:
     """Renders the HDL-32E of a world's own ship.
 
@@ -440,52 +465,64 @@ class LidarRenderer:
 
     # ------------------------------------------------------------------ the run
 
+    def chunks(self, progress=None):
+        """Render the scenario a chunk (about one revolution) at a time, in time order.
+
+        Yields
+        ------
+        LidarChunk
+            The chunk's firings, data packets and their send times, and the position packets due in it.
+        """
+        rev_cycles = hdl32e.cycles_per_revolution(self.cfg.rotation_hz)
+        chunk_packets = max(1, int(np.ceil(rev_cycles / self.cycles_per_packet)))
+        next_position_s = 0.0
+        starts = range(0, self.n_packets, chunk_packets)
+        for first_packet in (progress(starts) if progress else starts):
+            chunk_started = time.perf_counter()
+            packets_here = min(chunk_packets, self.n_packets - first_packet)
+            k0 = first_packet * self.cycles_per_packet
+            cycles = k0 + np.arange(packets_here * self.cycles_per_packet)
+            t = cycles * hdl32e.CYCLE_DT_S
+            block_az = hdl32e.block_azimuth_centideg(t, self.cfg.rotation_hz, self.cfg.azimuth0_deg)
+            blocks = hdl32e.BLOCKS_PER_PACKET
+            az_blocks = (np.repeat(block_az, DUAL_RETURNS) if self.dual else block_az).reshape(-1, blocks)
+            firing_az = hdl32e.decoder_azimuths_centideg(az_blocks, dual=self.dual)
+            firing_az = firing_az[:, ::2] if self.dual else firing_az
+            fire = self.measure(t, block_az, firing_az.reshape(-1, hdl32e.N_LASERS))
+            payloads = self.packets(fire)
+            sent = t[:: self.cycles_per_packet] + self.cycles_per_packet * hdl32e.CYCLE_DT_S
+            # position packets due within this chunk go in time order with the data packets
+            t_end = t[-1] + hdl32e.CYCLE_DT_S
+            position_times = []
+            while self.cfg.position_packet_rate_hz > 0 and next_position_s < t_end:
+                position_times.append(next_position_s)
+                next_position_s += 1.0 / self.cfg.position_packet_rate_hz
+            yield LidarChunk(t, fire, payloads, sent, position_times)
+            self.chunk_wall_s.append((t_end - t[0], time.perf_counter() - chunk_started))
+
     def run(self, out_dir: Path, progress=None) -> dict:
         """Render the whole scenario into ``out_dir/lidar``; returns counts for the manifest."""
         lidar_dir = out_dir / "lidar"
         sweeps_dir = lidar_dir / "sweeps"
         sweeps_dir.mkdir(parents=True, exist_ok=True)
-        rev_cycles = hdl32e.cycles_per_revolution(self.cfg.rotation_hz)
-        chunk_packets = max(1, int(np.ceil(rev_cycles / self.cycles_per_packet)))
         counts = {"packets": 0, "position_packets": 0, "sweeps": 0, "points": 0}
         pending: list[dict] = []
         current_rev = 0
-        next_position_s = 0.0
         with atomic_path(lidar_dir / "hdl32e.pcap") as tmp, open(tmp, "wb") as handle:
             pcap = PcapWriter(handle)
-            starts = range(0, self.n_packets, chunk_packets)
-            for first_packet in (progress(starts) if progress else starts):
-                chunk_started = time.perf_counter()
-                packets_here = min(chunk_packets, self.n_packets - first_packet)
-                k0 = first_packet * self.cycles_per_packet
-                cycles = k0 + np.arange(packets_here * self.cycles_per_packet)
-                t = cycles * hdl32e.CYCLE_DT_S
-                block_az = hdl32e.block_azimuth_centideg(t, self.cfg.rotation_hz, self.cfg.azimuth0_deg)
-                blocks = hdl32e.BLOCKS_PER_PACKET
-                az_blocks = (np.repeat(block_az, DUAL_RETURNS) if self.dual else block_az).reshape(-1, blocks)
-                firing_az = hdl32e.decoder_azimuths_centideg(az_blocks, dual=self.dual)
-                firing_az = firing_az[:, ::2] if self.dual else firing_az
-                fire = self.measure(t, block_az, firing_az.reshape(-1, hdl32e.N_LASERS))
-                payloads = self.packets(fire)
-                sent = t[:: self.cycles_per_packet] + self.cycles_per_packet * hdl32e.CYCLE_DT_S
-                # position packets due within this chunk go in time order with the data packets
-                t_end = t[-1] + hdl32e.CYCLE_DT_S
-                position_times = []
-                while self.cfg.position_packet_rate_hz > 0 and next_position_s < t_end:
-                    position_times.append(next_position_s)
-                    next_position_s += 1.0 / self.cfg.position_packet_rate_hz
-                self._write_in_order(pcap, payloads, sent, position_times)
-                counts["packets"] += payloads.shape[0]
-                counts["position_packets"] += len(position_times)
+            for chunk in self.chunks(progress):
+                t = chunk.time_s
+                self._write_in_order(pcap, chunk.payloads, chunk.sent_s, chunk.position_times_s)
+                counts["packets"] += chunk.payloads.shape[0]
+                counts["position_packets"] += len(chunk.position_times_s)
                 revolution = np.floor((self.cfg.azimuth0_deg + DEG_PER_TURN * self.cfg.rotation_hz * t) / DEG_PER_TURN).astype(np.int64)
-                pts, cycle_of_point = self.points(fire)
+                pts, cycle_of_point = self.points(chunk.firings)
                 point_rev = revolution[cycle_of_point]
                 for rev in np.unique(revolution):
                     if rev > current_rev:
                         self._flush(sweeps_dir, current_rev, pending, counts)
                         pending, current_rev = [], int(rev)
                     pending.append({k: v[point_rev == rev] for k, v in pts.items()})
-                self.chunk_wall_s.append((t[-1] + hdl32e.CYCLE_DT_S - t[0], time.perf_counter() - chunk_started))
             # the last revolution is written only if it is complete
             t_next = self.n_packets * self.cycles_per_packet * hdl32e.CYCLE_DT_S
             if np.floor((self.cfg.azimuth0_deg + DEG_PER_TURN * self.cfg.rotation_hz * t_next) / DEG_PER_TURN) > current_rev:
