@@ -1,0 +1,1 @@
+"""Live mode: raysim as the vessel's sensors on the network (docs/live.md)."""
