@@ -155,6 +155,9 @@ def build_parser() -> argparse.ArgumentParser:
     rcs.add_argument("--bounces", type=_count("--bounces"), default=3, help="maximum bounces per ray")
     rcs.add_argument("--ray-spacing-m", type=float, help="ray-tube side, m (default lambda/4, coarser for big meshes)")
     rcs.add_argument("--json", type=Path, help="also write the results as JSON")
+    from raysim.live.command import add_live_parser
+
+    add_live_parser(sub, _duration, _seed)
     return parser
 
 
@@ -350,8 +353,15 @@ def cmd_bench(args) -> int:
     return 0
 
 
+def cmd_live(args) -> int:
+    """Live mode: the sensors' packets on the network on the wall clock (raysim.live)."""
+    from raysim.live.command import cmd_live as live
+
+    return live(args, _load)
+
+
 COMMANDS = {"render": cmd_render, "run": cmd_run, "batch": cmd_batch, "import-hilsim": cmd_import_hilsim,
-            "bench": cmd_bench, "rcs": cmd_rcs}
+            "bench": cmd_bench, "rcs": cmd_rcs, "live": cmd_live}
 
 
 def main(argv: list[str] | None = None) -> int:

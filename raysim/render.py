@@ -255,7 +255,8 @@ def _write_scenario_files(ctx: RenderContext, scenario: Scenario) -> None:
 
 
 def render(scenario: Scenario, out_dir: Path, progress: bool | None = None, formats: tuple[str, ...] = (),
-           after_sensors: Callable[[Path], dict[str, int]] | None = None) -> RenderResult:
+           after_sensors: Callable[[Path], dict[str, int]] | None = None, own_ship_motion=None,
+           extra_counts: dict[str, int] | None = None) -> RenderResult:
     """Render ``scenario`` into ``out_dir``; all or nothing.
 
     Parameters
@@ -273,17 +274,24 @@ def render(scenario: Scenario, out_dir: Path, progress: bool | None = None, form
         Called with the staged recording directory once the sensors' files and a provisional
         manifest are written (``raysim run`` runs the TDM here, so its targets join the bag);
         returns counts to add to the manifest. An error in it leaves nothing on disk.
+    own_ship_motion : raysim.motion.Motion, optional
+        The own ship's motion instead of the scenario's (``raysim live --record`` with a fed own ship).
+    extra_counts : dict, optional
+        Counts to add to the manifest (``raysim live --record``: what was sent and how late).
     """
     bars = progress_bars(progress)  # the stages' own tqdm bars
     started = time.perf_counter()
     wall: dict[str, float] = {}
     with stage("world", progress, f"meshes and motions of {scenario.name}") as step:
         world = World(scenario)
+        if own_ship_motion is not None:
+            world.drive_own_ship(own_ship_motion)
         step.done = f"{len(world.objects)} objects"
     wall["world"] = step.elapsed_s
     enabled = scenario.sensors.enabled_names()
     with StagedDirectory(Path(out_dir)) as staged:
         ctx = RenderContext(world, staged.path, bars, wall_time_s=wall)
+        ctx.counts.update(extra_counts or {})
         _write_scenario_files(ctx, scenario)
         for name, write in (("truth", write_truth), ("ownship", write_ownship)):
             with stage(name, progress, f"{scenario.duration_s:g} s", bar=True) as step:

@@ -9,7 +9,7 @@ hands them to the ray engine.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -87,6 +87,11 @@ class World:
     @property
     def own_ship(self) -> WorldObject:
         return self.objects[0]
+
+    def drive_own_ship(self, motion) -> None:
+        """Give the own ship another motion (:class:`raysim.motion.Motion`; live mode's fed own ship)."""
+        self.objects = (replace(self.objects[0], motion=motion),) + self.objects[1:]
+        self._scene_objects = None
 
     def scene_objects(self) -> list:
         """The objects as the ray engine wants them (:class:`raysim.scene.SceneObject`)."""
