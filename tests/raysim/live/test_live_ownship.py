@@ -1,0 +1,84 @@
+"""raysim live --ownship-in: NMEA fed from outside moves the own ship, and the LiDAR sees it move."""
+
+from __future__ import annotations
+
+import datetime as dt
+import socket
+import threading
+import time
+
+import numpy as np
+import pytest
+import yaml
+
+from raysim.cli import main
+from raysim.recording import nmea
+from tests.raysim.helpers import box_file, latlon, scenario
+from tests.raysim.live.receivers import Receiver
+
+WALL_NORTH_M = 30.0
+MOVED_NORTH_M = 5.0
+
+
+def free_port() -> int:
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def feed(port: int, lidar: Receiver, stop: threading.Event) -> None:
+    """GGA + HDT + VTG at 10 Hz: at the origin for 2 s after the first LiDAR packet, then 5 m north."""
+    deadline = time.perf_counter() + 30.0
+    while not lidar.datagrams and time.perf_counter() < deadline and not stop.is_set():
+        time.sleep(0.01)
+    first = time.perf_counter()
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        while not stop.is_set() and time.perf_counter() < deadline:
+            north = 0.0 if time.perf_counter() - first < 2.0 else MOVED_NORTH_M
+            lat, lon = latlon(0.0, north)
+            utc = dt.datetime.now(dt.timezone.utc)
+            for line in (nmea.gpgga(utc, lat, lon, 0.0), nmea.hehdt(0.0), nmea.gpvtg(0.0, 0.0)):
+                s.sendto((line + "\r\n").encode("ascii"), ("127.0.0.1", port))
+            time.sleep(0.1)
+
+
+def forward_ranges(packets: list[bytes]) -> list[float]:
+    """Median range (m) of the points within 2 deg of dead ahead, per decoded revolution."""
+    vd = pytest.importorskip("velodyne_decoder")
+    decoder = vd.StreamDecoder(vd.Config(model=vd.Model.HDL32E, min_range=0.0, max_range=200.0))
+    out = []
+    for k, p in enumerate(packets):
+        scan = decoder.decode(k * 1e-3, p, as_pcl_structs=True)
+        if scan is None:
+            continue
+        cloud = scan[1]
+        ahead = (np.abs(np.degrees(np.arctan2(cloud["y"], cloud["x"]))) < 2.0) & (cloud["x"] > 10.0)
+        if np.count_nonzero(ahead) > 5:
+            out.append(float(np.median(np.hypot(cloud["x"][ahead], cloud["y"][ahead]))))
+    return out
+
+
+def test_nmea_fed_to_ownship_in_moves_the_own_ship_and_the_wall_comes_nearer(tmp_path):
+    wall = {"name": "wall", "kind": "mesh", "mesh": box_file(tmp_path, "wall", (40.0, 2.0, 10.0), (0.0, 0.0, 4.0)),
+            "position": latlon(0.0, WALL_NORTH_M + 1.0), "heading_deg": 90.0}  # its 40 m face across the bow
+    data = scenario(tmp_path, obstacles=[wall], duration=6.0)
+    data["sensors"] = {"lidar": {"mount": {"x_m": 0.0, "z_m": 3.0}}, "radar": {"enabled": False},
+                       "ais": {"enabled": False}}
+    path = tmp_path / "wall.yaml"
+    path.write_text(yaml.safe_dump(data))
+    lidar, port, stop = Receiver(), free_port(), threading.Event()
+    feeder = threading.Thread(target=feed, args=(port, lidar, stop), daemon=True)
+    feeder.start()
+    try:
+        code = main(["live", str(path), "--lidar-port", str(lidar.port), "--lidar-position-port", "0",
+                     "--nav-port", "0", "--ais-port", "0", "--radar-port", "0", "--ownship-in", str(port)])
+    finally:
+        stop.set()
+        lidar.close()
+        feeder.join(timeout=2.0)
+    assert code == 0
+    ranges = forward_ranges(lidar.payloads)
+    assert len(ranges) >= 40
+    before, after = np.median(ranges[:10]), np.median(ranges[-10:])
+    assert abs(before - WALL_NORTH_M) < 0.3  # the wall's face at 30 m from the origin
+    assert abs((before - after) - MOVED_NORTH_M) < 0.1  # nearer by the distance the fed own ship moved
