@@ -22,11 +22,9 @@ import numpy as np
 
 from groundfloor import hdl32e
 from groundfloor.frames import mount_transform  # noqa: F401 (raysim.sensors.lidar.mount_transform)
-from groundfloor.recording import LIDAR_SWEEP
 from raysim.materials import material_index, material_table
 from raysim.random_streams import stream
 from raysim.recording import nmea
-from raysim.recording.npz import write_sweep
 from raysim.recording.staging import atomic_path
 from raysim.recording.velodyne import PcapWriter, encode_data_packets, encode_position_packet
 from raysim.scene import NO_HIT, SEA_ID, intersect_sea
@@ -502,32 +500,20 @@ class LidarRenderer:
 
     def run(self, out_dir: Path, progress=None) -> dict:
         """Render the whole scenario into ``out_dir/lidar``; returns counts for the manifest."""
+        from raysim.sensors.lidar_sweeps import LidarSweeps
+
         lidar_dir = out_dir / "lidar"
-        sweeps_dir = lidar_dir / "sweeps"
-        sweeps_dir.mkdir(parents=True, exist_ok=True)
-        counts = {"packets": 0, "position_packets": 0, "sweeps": 0, "points": 0}
-        pending: list[dict] = []
-        current_rev = 0
+        sweeps = LidarSweeps(self, lidar_dir / "sweeps")
+        counts = {"packets": 0, "position_packets": 0}
         with atomic_path(lidar_dir / "hdl32e.pcap") as tmp, open(tmp, "wb") as handle:
             pcap = PcapWriter(handle)
             for chunk in self.chunks(progress):
-                t = chunk.time_s
                 self._write_in_order(pcap, chunk.payloads, chunk.sent_s, chunk.position_times_s)
                 counts["packets"] += chunk.payloads.shape[0]
                 counts["position_packets"] += len(chunk.position_times_s)
-                revolution = np.floor((self.cfg.azimuth0_deg + DEG_PER_TURN * self.cfg.rotation_hz * t) / DEG_PER_TURN).astype(np.int64)
-                pts, cycle_of_point = self.points(chunk.firings)
-                point_rev = revolution[cycle_of_point]
-                for rev in np.unique(revolution):
-                    if rev > current_rev:
-                        self._flush(sweeps_dir, current_rev, pending, counts)
-                        pending, current_rev = [], int(rev)
-                    pending.append({k: v[point_rev == rev] for k, v in pts.items()})
-            # the last revolution is written only if it is complete
-            t_next = self.n_packets * self.cycles_per_packet * hdl32e.CYCLE_DT_S
-            if np.floor((self.cfg.azimuth0_deg + DEG_PER_TURN * self.cfg.rotation_hz * t_next) / DEG_PER_TURN) > current_rev:
-                self._flush(sweeps_dir, current_rev, pending, counts)
-        return counts
+                sweeps.add(chunk)
+            sweeps.finish()
+        return {**counts, **sweeps.counts}
 
     def _write_in_order(self, pcap: PcapWriter, payloads: np.ndarray, sent: np.ndarray, position_times: list[float]) -> None:
         if not position_times:
@@ -543,13 +529,6 @@ class LidarRenderer:
             pcap.write_udp(packet, hdl32e.POSITION_PORT, np.array([self.start_unix_s + tp]))
         if cut < payloads.shape[0]:
             pcap.write_udp(payloads[cut:], hdl32e.DATA_PORT, self.start_unix_s + sent[cut:])
-
-    def _flush(self, sweeps_dir: Path, rev: int, pending: list[dict], counts: dict) -> None:
-        arrays = {k: np.concatenate([p[k] for p in pending]) for k in pending[0]}
-        write_sweep(sweeps_dir, rev, LIDAR_SWEEP, arrays)
-        counts["sweeps"] += 1
-        counts["points"] += int(arrays["x"].shape[0])
-
 
 def render_lidar(ctx: SensorContext) -> None:
     """The ``lidar`` entry of :data:`raysim.render.SENSOR_RENDERERS`."""
