@@ -27,7 +27,7 @@ from __future__ import annotations
 import shutil
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Callable, Iterable
+from typing import Callable, Iterable, Iterator
 
 import numpy as np
 
@@ -45,7 +45,7 @@ from tdm.tracker import AisTracker, PositionTracker, TrackerConfig
 from tdm.workers import BATCH_SCANS, LIDAR_FIELDS, RADAR_FIELDS
 
 __all__ = ["BATCH_SCANS", "DetectionStream", "FUSION_RULES", "LIDAR_FIELDS", "LIDAR_SOURCES", "RADAR_FIELDS",
-           "RunResult", "TdmConfig", "run_tdm", "start_time_unix_s"]
+           "RunResult", "TdmConfig", "run_tdm", "start_time_unix_s", "targets_by_epoch"]
 
 #: Tolerance of the epoch count ``floor(duration x rate)``: a product that falls a rounding error
 #: short of a whole number still counts its last epoch.
@@ -162,6 +162,33 @@ def _track_and_write(tracking: _Tracking, events: Iterable, epochs: _EpochTimes,
         while k < len(epochs):
             emit(float(epochs[k]))
             k += 1
+
+
+def targets_by_epoch(stream: DetectionStream, config: TdmConfig, duration_s: float
+                     ) -> Iterator[tuple[float, list[dict]]]:
+    """The detected-target records of every output epoch ``k / update_rate_hz`` (s), as the events pass it.
+
+    The same trackers and fuser as :func:`run_tdm`, yielding instead of writing: live mode's TDM, whose
+    scans arrive while it runs (:meth:`DetectionStream.follow`).
+    """
+    tracking = _Tracking(stream, config)
+    epochs = _EpochTimes(int(np.floor(duration_s * config.update_rate_hz + _EPOCH_COUNT_TOLERANCE)),
+                         config.update_rate_hz)
+    k = 0
+
+    def emitted(t_out: float) -> tuple[float, list[dict]]:
+        records: list[dict] = []
+        tracking.emit(t_out, records.append, lambda record: None)
+        return t_out, records
+
+    for t_end, sensor, payload in stream.events():
+        while k < len(epochs) and t_end > epochs[k]:
+            yield emitted(float(epochs[k]))
+            k += 1
+        tracking.process(t_end, sensor, payload)
+    while k < len(epochs):
+        yield emitted(float(epochs[k]))
+        k += 1
 
 
 def run_tdm(recording: Path, out_dir: Path | None = None, config: TdmConfig | None = None,

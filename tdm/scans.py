@@ -153,6 +153,11 @@ class DetectionStream:
         if not self._jobs and not has_ais:
             raise RecordingError(str(rec), "(directory)", "holds no LiDAR, radar or AIS data to detect targets in")
 
+    def follow(self, jobs: Jobs) -> None:
+        """Take the scans from ``jobs`` instead of the recording's files (live mode: scans that arrive while
+        the stream runs; per sensor an iterator of ``(sensor, sweep path)`` in time order and the scan period, s)."""
+        self._jobs = dict(jobs)
+
     def events(self) -> Iterator[tuple[float, str, object]]:
         """(time s, sensor, Detections or AisReport) in time order (a scan at its last point's time)."""
         longest_period_s = max((period for _, period in self._jobs.values()), default=0.0)

@@ -6,7 +6,6 @@ import argparse
 import sys
 from pathlib import Path
 
-from raysim.errors import InputError
 
 __all__ = ["add_live_parser", "cmd_live", "live_counts"]
 
@@ -44,11 +43,11 @@ def add_live_parser(sub, duration_type, seed_type) -> None:
                                 ("radar-port", 6678, "Navico Broadband spokes"),
                                 ("ais-port", 10110, "!AIVDM lines"),
                                 ("nav-port", 10111, "own-ship GGA, RMC, HDT, VTG, ZDA"),
-                                ("targets-port", 0, "detected targets as JSON lines (not available yet)")):
+                                ("targets-port", 0, "the live TDM's detected targets as JSON lines")):
         p.add_argument(f"--{name}", type=_port, default=default, help=f"{what}; 0 = off (default {default})")
     p.add_argument("--radar-multicast", action="store_true", help="spokes to 236.6.7.8:6678 as the real set sends")
     p.add_argument("--ownship-in", type=_port, help="listen on 127.0.0.1:PORT for the own ship's NMEA")
-    p.add_argument("--foxglove", type=_port, help="Foxglove WebSocket server port (not available yet)")
+    p.add_argument("--foxglove", type=_port, help="serve the session to Foxglove on 127.0.0.1:PORT (WebSocket)")
     p.add_argument("--record", type=Path, help="write the usual recording directory of the session")
     p.add_argument("--no-progress", action="store_true", help="no progress while the record is written")
 
@@ -69,13 +68,9 @@ def cmd_live(args, load) -> int:
     from raysim.live.session import LivePorts, run_live
     from raysim.scenario import with_overrides
 
-    if args.targets_port:
-        raise InputError("--targets-port: the live TDM is not available yet (docs/live.md); leave it at 0")
-    if args.foxglove:
-        raise InputError("--foxglove: the live Foxglove server is not available yet (docs/live.md)")
     scenario = load(args)
     ports = LivePorts(args.dest, args.lidar_port, args.lidar_position_port, args.radar_port, args.ais_port,
-                      args.nav_port, args.radar_multicast)
+                      args.nav_port, args.radar_multicast, args.targets_port, args.foxglove)
     print(f"live: {scenario.name}, {scenario.duration_s:g} s at {args.speed:g}x real time, to {args.dest}",
           file=sys.stderr)
     result, world = run_live(scenario, ports, args.speed, args.ownship_in)

@@ -115,3 +115,50 @@ def _le16(values: np.ndarray) -> np.ndarray:
     """(S, 2) little-endian bytes of 16-bit values."""
     v = np.asarray(values, np.int64) & 0xFFFF
     return np.stack([v & 0xFF, v >> 8], axis=1).astype(np.uint8)
+
+
+#: Where a Navico radar announces itself (radar_pi ``NavicoLocate.cpp``: the 01 B2 beacon).
+BEACON_ADDRESS = ("236.6.7.5", 6878)
+#: Field layout of the 01 B2 beacon (radar_pi ``RadarReport_01B2``): id, serial number, then address
+#: blocks of 4 bytes of IPv4 and 2 of port (network order) with unknown bytes between; radar A's data,
+#: command and report addresses are the 6th, 7th and 8th address blocks (radar B's the 9th to 11th).
+BEACON_FORMAT = "<H16s6s12s6s4s6s10s6s4s6s10s6s4s6s4s6s10s6s4s6s4s6s10s6s4s6s4s6s10s6s4s6s4s6s"
+#: Radar A's command and report groups of a Broadband 4G (radar_pi ``NavicoCommon.h``).
+COMMAND_ADDRESS = ("236.6.7.10", 6680)
+REPORT_ADDRESS = ("236.6.7.9", 6679)
+#: The beacon's serial number field (ASCII): says what sends it.
+BEACON_SERIAL = b"RAYSIM"
+
+
+def _packed(address: tuple[str, int]) -> bytes:
+    host, port = address
+    return bytes(int(v) for v in host.split(".")) + int(port).to_bytes(2, "big")
+
+
+def beacon(data_address: tuple[str, int] = RADAR_MULTICAST, command_address: tuple[str, int] = COMMAND_ADDRESS,
+           report_address: tuple[str, int] = REPORT_ADDRESS) -> bytes:
+    """The 01 B2 beacon announcing radar A's spoke, command and report groups (radar B: the same).
+
+    Only the addresses and the id are meaningful here; the unknown bytes are zeros, and the other
+    address blocks repeat radar A's (the real set fills them with its other groups).
+    """
+    import struct
+
+    sizes = [int(n) for n in BEACON_FORMAT[1:].replace("H", "").split("s") if n]
+    fields: list = [0x01 | (0xB2 << 8), BEACON_SERIAL.ljust(16, b"\0")]
+    addresses = [data_address, command_address, report_address]
+    k = 0
+    for size in sizes[1:]:
+        if size == 6:
+            fields.append(_packed(addresses[(k - 5) % 3] if k >= 5 else data_address))
+            k += 1
+        else:
+            fields.append(bytes(size))
+    return struct.pack(BEACON_FORMAT, *fields)
+
+
+def status_report(transmitting: bool = True) -> bytes:
+    """The 18-byte 01 C4 status report (radar_pi ``RadarReport_01C4_18``: byte 2 = 0x02 transmit, 0x01 standby)."""
+    body = bytearray(18)
+    body[0], body[1], body[2] = 0x01, 0xC4, 0x02 if transmitting else 0x01
+    return bytes(body)

@@ -123,6 +123,10 @@ class LiveStream:
     batch: Batch | None = None
     index: int = 0
     finished: bool = False
+    #: rendered for the live TDM only (its port 0): consumed on time, nothing sent
+    muted: bool = False
+    #: print "behind its schedule" lines (not for the TDM's targets: their lateness is the TDM's latency)
+    report_behind: bool = True
 
     def next_time(self) -> float | None:
         """Scenario time of the next payload (None: nothing rendered yet, or the stream is over)."""
@@ -183,6 +187,8 @@ def send_streams(streams: list[LiveStream], sock: socket.socket, start_wall_s: f
             time.sleep(min(wait_s, POLL_S))
             continue
         _send_due(stream, sock, start_wall_s, speed, lateness)
+        if stream.muted or not stream.report_behind:
+            continue
         worst = lateness.late_s[stream.name][-1].max()
         if worst > LATE_S and now - last_report[stream.name] > REPORT_EVERY_S:
             last_report[stream.name] = now
@@ -196,6 +202,11 @@ def _send_due(stream: LiveStream, sock: socket.socket, start_wall_s: float, spee
     batch = stream.batch
     clock_s = (time.perf_counter() - start_wall_s) * speed
     stop = max(stream.index + 1, int(np.searchsorted(batch.times_s, clock_s, side="right")))
+    if stream.muted:
+        stream.index = stop
+        if stop >= len(batch.payloads):
+            stream.batch = None
+        return
     sent_at = np.empty(stop - stream.index)
     for k in range(stream.index, stop):
         sock.sendto(batch.payloads[k], stream.address)

@@ -8,16 +8,19 @@ the recording's manifest (``--record``).
 
 from __future__ import annotations
 
+import json
 import socket
 import sys
+import tempfile
 import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from raysim.live.navico import RADAR_MULTICAST
+from raysim.live.navico import BEACON_ADDRESS, RADAR_MULTICAST, REPORT_ADDRESS, beacon, status_report
 from raysim.live.sender import LiveStream, Lateness, Producer, send_streams
-from raysim.live.streams import ais_batches, lidar_data_batches, lidar_position_batches, nav_batches, radar_batches
+from raysim.live.streams import (ais_batches, announcements, lidar_data_batches, lidar_position_batches, nav_batches,
+                                 radar_batches)
 from raysim.scenario import Scenario
 from raysim.world import World
 
@@ -45,6 +48,8 @@ class LivePorts:
     ais: int = 10110
     nav: int = 10111
     radar_multicast: bool = False
+    targets: int = 0
+    foxglove: int | None = None
 
 
 @dataclass
@@ -57,29 +62,53 @@ class LiveResult:
     stale_events: int = 0
 
 
-def _streams(world: World, scene_factory, ports: LivePorts, stop: threading.Event, ready_before) -> list[LiveStream]:
-    """A LiveStream per enabled sensor whose port is not 0."""
+def _streams(world: World, scene_factory, ports: LivePorts, stop: threading.Event, ready_before,
+             working: Path | None, on_targets=None) -> list[LiveStream]:
+    """A LiveStream per enabled sensor whose port is not 0 (and the TDM's, with a working recording)."""
     s = world.scenario
     enabled = set(s.sensors.enabled_names())
     out: list[tuple[str, tuple[str, int], object]] = []
-    if "lidar" in enabled and (ports.lidar or ports.lidar_position):
+    done: dict[str, threading.Event] = {}
+    if "lidar" in enabled and (ports.lidar or ports.lidar_position or working is not None):
         from raysim.sensors.lidar import LidarRenderer
 
         lidar = LidarRenderer(world, scene_factory())  # the position packets only read the own ship's pose
-        if ports.lidar:
-            out.append(("lidar", (ports.dest, ports.lidar), lidar_data_batches(lidar)))
+        done["lidar"] = threading.Event()
+        sweeps = working / "lidar" / "sweeps" if working is not None else None
+        out.append(("lidar", (ports.dest, ports.lidar), lidar_data_batches(lidar, sweeps, done["lidar"])))
         if ports.lidar_position:
             out.append(("lidar_position", (ports.dest, ports.lidar_position), lidar_position_batches(lidar)))
-    if "radar" in enabled and ports.radar:
+    if "radar" in enabled and (ports.radar or working is not None):
         from raysim.sensors.radar import RadarRenderer
 
         address = RADAR_MULTICAST if ports.radar_multicast else (ports.dest, ports.radar)
-        out.append(("radar", address, radar_batches(RadarRenderer(world, scene_factory()))))
+        if ports.radar_multicast:  # as the real set: its beacon (where its groups are) and status (transmitting)
+            out.append(("radar_beacon", BEACON_ADDRESS, announcements(s.duration_s, beacon())))
+            out.append(("radar_report", REPORT_ADDRESS, announcements(s.duration_s, status_report())))
+        done["radar"] = threading.Event()
+        sweeps = working / "radar" / "sweeps" if working is not None else None
+        out.append(("radar", address, radar_batches(RadarRenderer(world, scene_factory()), sweeps_dir=sweeps,
+                                                    done=done["radar"])))
     if "ais" in enabled and ports.ais:
         out.append(("ais", (ports.dest, ports.ais), ais_batches(world)))
     if "nav" in enabled and ports.nav:
         out.append(("nav", (ports.dest, ports.nav), nav_batches(world)))
-    return [LiveStream(name, address, Producer(name, batches, stop, ready_before)) for name, address, batches in out]
+    if working is not None:
+        from raysim.live.targets import target_batches
+
+        targets = target_batches(working, done, stop)
+        out.append(("targets", (ports.dest, ports.targets), _tee(targets, on_targets) if on_targets else targets))
+    # a sensor rendered only for the TDM or the Foxglove view (its port 0) sends nothing
+    muted = {"lidar": not ports.lidar, "radar": not ports.radar, "targets": not ports.targets}
+    return [LiveStream(name, address, Producer(name, batches, stop, ready_before), muted=muted.get(name, False),
+                       report_behind=name != "targets") for name, address, batches in out]
+
+
+def _tee(batches, see):
+    """The batches, each also shown to ``see(t_s, records)`` (the Foxglove view of the targets)."""
+    for batch in batches:
+        see(float(batch.times_s[0]), [json.loads(p) for p in batch.payloads])
+        yield batch
 
 
 def _scene_factory(world: World):
@@ -97,6 +126,92 @@ def _scene_factory(world: World):
     return scene
 
 
+class _Session:
+    """A session's parts: the world, the fed own ship, the working recording, the Foxglove view, the streams."""
+
+    def __init__(self, scenario: Scenario, ports: LivePorts, speed: float, ownship_port: int | None):
+        self.scenario, self.ports, self.speed = scenario, ports, speed
+        self.world = World(scenario)
+        self.start_wall_s: float | None = None
+        self.stop = threading.Event()
+        self.feed = self.view = self.working_dir = None
+        ready_before = None
+        if ownship_port is not None:
+            from raysim.live.ownship_in import FedMotion, OwnShipFeed
+
+            self.feed = OwnShipFeed(ownship_port, self.world.frame, self.clock)
+            self.world.drive_own_ship(FedMotion(self.feed, self.world.own_ship.motion))
+            ready_before = self._fed_lead
+        working = self._working_recording()
+        see = None
+        if ports.foxglove is not None:
+            from raysim.live.foxglove_view import FoxgloveView
+
+            self.view = FoxgloveView(ports.foxglove, working, self.clock, scenario.start_time.timestamp(),
+                                     self.world.frame.to_local, self.stop)
+            see = lambda t_s, records: self.view.targets.put((t_s, records))  # noqa: E731
+        self.streams = _streams(self.world, _scene_factory(self.world), ports, self.stop, ready_before, working, see)
+
+    def clock(self) -> float:
+        """Scenario time on the session's clock, s (0 until it starts)."""
+        return 0.0 if self.start_wall_s is None else (time.perf_counter() - self.start_wall_s) * self.speed
+
+    def _fed_lead(self, t_s: float) -> None:
+        """Hold a producer until the clock is within FED_LEAD_S of ``t_s`` (the fed pose's extrapolation)."""
+        while not self.stop.is_set() and self.clock() < t_s - FED_LEAD_S:
+            time.sleep(0.01)
+
+    def _working_recording(self) -> Path | None:
+        """The live TDM's and the Foxglove view's working recording (None if neither is on)."""
+        if not self.ports.targets and self.ports.foxglove is None:
+            return None
+        from raysim.live.targets import prepare_working_recording
+
+        self.working_dir = tempfile.TemporaryDirectory(prefix="raysim-live-")
+        working = Path(self.working_dir.name) / "rec"
+        prepare_working_recording(self.scenario, working)
+        return working
+
+    def run(self, log) -> LiveResult:
+        """Start the producers, wait for their first batches, send on the clock; stop everything at the end."""
+        sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        if self.ports.radar_multicast:
+            sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, MULTICAST_TTL)
+        lateness, interrupted, reached = Lateness(), False, 0.0
+        switch_interval = sys.getswitchinterval()
+        sys.setswitchinterval(SWITCH_INTERVAL_S)
+        try:
+            for s in self.streams:
+                s.producer.start()
+            _preroll(self.streams, self.stop)
+            self.start_wall_s = time.perf_counter()
+            if self.view is not None:
+                self.view.start()
+            reached = send_streams(self.streams, sock, self.start_wall_s, self.speed, self.scenario.duration_s,
+                                   lateness, self.stop, log)
+        except KeyboardInterrupt:
+            interrupted, reached = True, self.clock()
+        finally:
+            sys.setswitchinterval(switch_interval)
+            sock.close()
+            self.close()
+        stale = self.feed.stale_events if self.feed is not None else 0
+        return LiveResult(reached, interrupted, lateness.summary(), stale)
+
+    def close(self) -> None:
+        """Stop the producers, the own-ship feed and the Foxglove view; remove the working recording."""
+        self.stop.set()
+        for s in self.streams:
+            s.producer.join(timeout=5.0)
+        if self.feed is not None:
+            self.feed.close()
+        if self.view is not None:
+            self.view.join(timeout=2.0)
+            self.view.close()
+        if self.working_dir is not None:
+            self.working_dir.cleanup()
+
+
 def run_live(scenario: Scenario, ports: LivePorts, speed: float = 1.0, ownship_port: int | None = None,
              log=sys.stderr) -> tuple[LiveResult, World]:
     """Run one live session (module docstring); returns its result and the world it rendered.
@@ -111,53 +226,8 @@ def run_live(scenario: Scenario, ports: LivePorts, speed: float = 1.0, ownship_p
     ownship_port : int, optional
         Listen on 127.0.0.1:port for the own ship's NMEA (GGA, HDT, VTG, PSXN,23).
     """
-    world = World(scenario)
-    clock = {"start": None}
-
-    def scenario_clock() -> float:
-        return 0.0 if clock["start"] is None else (time.perf_counter() - clock["start"]) * speed
-
-    feed = None
-    ready_before = None
-    stop = threading.Event()
-    if ownship_port is not None:
-        from raysim.live.ownship_in import FedMotion, OwnShipFeed
-
-        feed = OwnShipFeed(ownship_port, world.frame, scenario_clock)
-        world.drive_own_ship(FedMotion(feed, world.own_ship.motion))
-
-        def ready_before(t_s: float) -> None:  # render no further ahead than the fed pose can be extrapolated
-            while not stop.is_set() and scenario_clock() < t_s - FED_LEAD_S:
-                time.sleep(0.01)
-
-    streams = _streams(world, _scene_factory(world), ports, stop, ready_before)
-    sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    if ports.radar_multicast:
-        sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, MULTICAST_TTL)
-    lateness = Lateness()
-    interrupted = False
-    reached = 0.0
-    switch_interval = sys.getswitchinterval()
-    sys.setswitchinterval(SWITCH_INTERVAL_S)
-    try:
-        for s in streams:
-            s.producer.start()
-        _preroll(streams, stop)
-        clock["start"] = time.perf_counter()
-        reached = send_streams(streams, sock, clock["start"], speed, scenario.duration_s, lateness, stop, log)
-    except KeyboardInterrupt:
-        interrupted = True
-        reached = scenario_clock()
-    finally:
-        sys.setswitchinterval(switch_interval)
-        stop.set()
-        for s in streams:
-            s.producer.join(timeout=5.0)
-        sock.close()
-        if feed is not None:
-            feed.close()
-    stale = getattr(feed, "stale_events", 0) if feed is not None else 0
-    return LiveResult(reached, interrupted, lateness.summary(), stale), world
+    session = _Session(scenario, ports, speed, ownship_port)
+    return session.run(log), session.world
 
 
 def _preroll(streams: list[LiveStream], stop: threading.Event) -> None:

@@ -9,18 +9,22 @@ wire is what the recording holds for the same scenario and seed.
 from __future__ import annotations
 
 import datetime as dt
+import threading
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Iterator
 
 import numpy as np
 
 from groundfloor import hdl32e
+from groundfloor.recording import RADAR_SWEEP
 from raysim.live.navico import SPOKES_PER_FRAME, spoke_frames
 from raysim.recording import nmea
+from raysim.recording.npz import write_sweep
 from raysim.world import World
 
 __all__ = ["Batch", "lidar_data_batches", "lidar_position_batches", "radar_batches", "ais_batches", "nav_batches",
-           "NAV_CHUNK_S"]
+           "NAV_CHUNK_S", "announcements"]
 
 #: Seconds of navigation formatted at a time (a short look-ahead, so a fed own ship is followed).
 NAV_CHUNK_S = 1.0
@@ -49,10 +53,26 @@ class Batch:
         return float(self.times_s[-1]) if len(self.payloads) else -np.inf
 
 
-def lidar_data_batches(renderer) -> Iterator[Batch]:
-    """The HDL-32E's 1206-byte data packets, a chunk (about one revolution) a batch, each at its send time."""
-    for chunk in renderer.chunks():
-        yield Batch(chunk.sent_s, [bytes(p) for p in chunk.payloads])
+def lidar_data_batches(renderer, sweeps_dir: Path | None = None, done: threading.Event | None = None
+                       ) -> Iterator[Batch]:
+    """The HDL-32E's 1206-byte data packets, a chunk (about one revolution) a batch, each at its send time.
+
+    With ``sweeps_dir`` the revolutions' sweep files are written there too (the live TDM reads them);
+    ``done`` is set once the last one is written.
+    """
+    from raysim.sensors.lidar_sweeps import LidarSweeps
+
+    sweeps = LidarSweeps(renderer, sweeps_dir) if sweeps_dir is not None else None
+    try:
+        for chunk in renderer.chunks():
+            if sweeps is not None:
+                sweeps.add(chunk)
+            yield Batch(chunk.sent_s, [bytes(p) for p in chunk.payloads])
+        if sweeps is not None:
+            sweeps.finish()
+    finally:
+        if done is not None:
+            done.set()
 
 
 def lidar_position_batches(renderer) -> Iterator[Batch]:
@@ -70,18 +90,26 @@ def lidar_position_batches(renderer) -> Iterator[Batch]:
         k += 1
 
 
-def radar_batches(renderer, spokes_per_frame: int = SPOKES_PER_FRAME) -> Iterator[Batch]:
+def radar_batches(renderer, spokes_per_frame: int = SPOKES_PER_FRAME, sweeps_dir: Path | None = None,
+                  done: threading.Event | None = None) -> Iterator[Batch]:
     """Spoke frames in the Navico Broadband 3G/4G format, a revolution a batch.
 
-    A frame leaves when its last spoke has been received: at that spoke's time.
+    A frame leaves when its last spoke has been received: at that spoke's time. With ``sweeps_dir`` each
+    revolution's NPZ sweep is written there too (the live TDM reads them); ``done`` is set after the last.
     """
     s = renderer.spokes
     index = np.arange(s)
     last = np.minimum(np.arange(0, s, spokes_per_frame) + spokes_per_frame - 1, s - 1)
-    for rev in range(renderer.n_revolutions):
-        r = renderer.revolution(rev)
-        frames = spoke_frames(r.echo, index, s, r.heading_deg, float(renderer.cfg.range_m), spokes_per_frame)
-        yield Batch(np.asarray(r.time, np.float64)[last], frames)
+    try:
+        for rev in range(renderer.n_revolutions):
+            r = renderer.revolution(rev)
+            if sweeps_dir is not None:
+                write_sweep(sweeps_dir, rev, RADAR_SWEEP, r.arrays())
+            frames = spoke_frames(r.echo, index, s, r.heading_deg, float(renderer.cfg.range_m), spokes_per_frame)
+            yield Batch(np.asarray(r.time, np.float64)[last], frames)
+    finally:
+        if done is not None:
+            done.set()
 
 
 def ais_batches(world: World) -> Iterator[Batch]:
@@ -117,6 +145,13 @@ def nav_batches(world: World) -> Iterator[Batch]:
             times += [t_s] * len(epoch)
             payloads += [(sentence + "\r\n").encode("ascii") for sentence in epoch]
         yield Batch(np.array(times, np.float64), payloads)
+
+
+def announcements(duration_s: float, payload: bytes, period_s: float = 1.0) -> Iterator[Batch]:
+    """One payload every ``period_s`` from t = 0 (the Navico beacon and status report), 10 s a batch."""
+    times = np.arange(0.0, duration_s, period_s)
+    for a in range(0, times.size, 10):
+        yield Batch(times[a:a + 10], [payload] * len(times[a:a + 10]))
 
 
 def _runs_by_time(times_s: np.ndarray, span_s: float) -> Iterator[tuple[int, int]]:

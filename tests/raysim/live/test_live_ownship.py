@@ -82,3 +82,29 @@ def test_nmea_fed_to_ownship_in_moves_the_own_ship_and_the_wall_comes_nearer(tmp
     before, after = np.median(ranges[:10]), np.median(ranges[-10:])
     assert abs(before - WALL_NORTH_M) < 0.3  # the wall's face at 30 m from the origin
     assert abs((before - after) - MOVED_NORTH_M) < 0.1  # nearer by the distance the fed own ship moved
+
+
+def test_sigterm_ends_a_live_session_cleanly_with_its_summary(tmp_path):
+    import signal
+    import subprocess
+    import sys
+
+    from tests.raysim.helpers import tiny_scenario
+
+    lidar = Receiver()
+    proc = subprocess.Popen([sys.executable, "-m", "raysim.cli", "live", str(tiny_scenario(tmp_path / "tiny")),
+                             "--duration", "60", "--lidar-port", str(lidar.port), "--lidar-position-port", "0",
+                             "--radar-port", "0", "--ais-port", "0", "--nav-port", "0"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.perf_counter() + 60.0
+        while len(lidar.datagrams) < 2000 and time.perf_counter() < deadline:
+            time.sleep(0.05)
+        proc.send_signal(signal.SIGTERM)
+        out, err = proc.communicate(timeout=20)
+    finally:
+        proc.kill()
+        lidar.close()
+    assert proc.returncode == 0, err
+    assert "live: interrupted at t = " in out
+    assert "live: lidar: " in out and "Traceback" not in err
