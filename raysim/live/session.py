@@ -134,13 +134,15 @@ class _Session:
         self.world = World(scenario)
         self.start_wall_s: float | None = None
         self.stop = threading.Event()
-        self.feed = self.view = self.working_dir = None
+        self.feed = self.fed = self.view = self.working_dir = None
         ready_before = None
         if ownship_port is not None:
             from raysim.live.ownship_in import FedMotion, OwnShipFeed
 
             self.feed = OwnShipFeed(ownship_port, self.world.frame, self.clock)
-            self.world.drive_own_ship(FedMotion(self.feed, self.world.own_ship.motion))
+            self.fed = FedMotion(self.feed, self.world.own_ship.motion,
+                                 on_message=lambda text: print(f"live: {text}", file=sys.stderr))
+            self.world.drive_own_ship(self.fed)
             ready_before = self._fed_lead
         working = self._working_recording()
         see = None
@@ -195,7 +197,7 @@ class _Session:
             sys.setswitchinterval(switch_interval)
             sock.close()
             self.close()
-        stale = self.feed.stale_events if self.feed is not None else 0
+        stale = self.fed.stale_events if self.feed is not None else 0
         return LiveResult(reached, interrupted, lateness.summary(), stale)
 
     def close(self) -> None:
@@ -206,7 +208,8 @@ class _Session:
         if self.feed is not None:
             self.feed.close()
         if self.view is not None:
-            self.view.join(timeout=2.0)
+            if self.view.ident is not None:  # started
+                self.view.join(timeout=2.0)
             self.view.close()
         if self.working_dir is not None:
             self.working_dir.cleanup()
@@ -231,10 +234,13 @@ def run_live(scenario: Scenario, ports: LivePorts, speed: float = 1.0, ownship_p
 
 
 def _preroll(streams: list[LiveStream], stop: threading.Event) -> None:
-    """Wait until every stream has its first batch (or is over): the clock starts with all of them ready."""
+    """Wait until every stream has its first batch (or is over): the clock starts with all of them ready.
+
+    Not the TDM's targets: its first epoch waits for scans that end after it, which need the clock.
+    """
     deadline = time.perf_counter() + PREROLL_TIMEOUT_S
     while not stop.is_set() and time.perf_counter() < deadline:
-        if all(s.next_time() is not None or s.finished for s in streams):
+        if all(s.next_time() is not None or s.finished or not s.report_behind for s in streams):
             return
         time.sleep(0.01)
     if not stop.is_set():

@@ -25,7 +25,7 @@ def free_tcp_port() -> int:
 
 
 class FoxgloveClient(threading.Thread):
-    """A Foxglove WebSocket (v1) client: takes the server's channels, subscribes to all, counts messages."""
+    """A Foxglove WebSocket client (subprotocol foxglove.sdk.v1, the SDK's): takes the server's channels, subscribes to all, counts messages."""
 
     def __init__(self, port: int):
         super().__init__(daemon=True)
@@ -44,7 +44,7 @@ class FoxgloveClient(threading.Thread):
         conn = None
         while conn is None and time.monotonic() < deadline and not self.stop.is_set():
             try:
-                conn = await websocket_connect(f"ws://127.0.0.1:{self.port}", subprotocols=["foxglove.websocket.v1"])
+                conn = await websocket_connect(f"ws://127.0.0.1:{self.port}", subprotocols=["foxglove.sdk.v1"])
             except OSError:
                 await asyncio.sleep(0.1)
         subscribed = set()
