@@ -239,6 +239,10 @@ def finished_row(spec: RunSpec, batch_dir: Path) -> dict | None:
 # ---------------------------------------------------------------------------------------------- the batch
 
 
+#: How long to try to reach a Dask scheduler given by address, s.
+SCHEDULER_TIMEOUT_S = 10.0
+
+
 def _client(scheduler: str | None, workers: int | None):
     """A Dask client: on the scheduler at ``scheduler``, or on a new LocalCluster (no dashboard)."""
     from distributed import Client, LocalCluster
@@ -247,7 +251,7 @@ def _client(scheduler: str | None, workers: int | None):
         logging.getLogger(name).setLevel(logging.ERROR)
     if scheduler:
         try:
-            return Client(scheduler, timeout="10s"), None
+            return Client(scheduler, timeout=f"{SCHEDULER_TIMEOUT_S:g}s"), None
         except (OSError, TimeoutError, ValueError) as exc:
             raise InputError("command line", "--scheduler", f"cannot connect to {scheduler}: {_one_line(exc)}") from None
     n = max(1, int(workers) if workers else (os.cpu_count() or 1))

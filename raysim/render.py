@@ -256,7 +256,7 @@ def _write_scenario_files(ctx: RenderContext, scenario: Scenario) -> None:
 
 def render(scenario: Scenario, out_dir: Path, progress: bool | None = None, formats: tuple[str, ...] = (),
            after_sensors: Callable[[Path], dict[str, int]] | None = None, own_ship_motion=None,
-           extra_counts: dict[str, int] | None = None) -> RenderResult:
+           extra_counts: dict[str, int] | None = None, derived: bool = True) -> RenderResult:
     """Render ``scenario`` into ``out_dir``; all or nothing.
 
     Parameters
@@ -278,6 +278,9 @@ def render(scenario: Scenario, out_dir: Path, progress: bool | None = None, form
         The own ship's motion instead of the scenario's (``raysim live --record`` with a fed own ship).
     extra_counts : dict, optional
         Counts to add to the manifest (``raysim live --record``: what was sent and how late).
+    derived : bool
+        Write the files made from the recording's own (the bag, map.png, the bird's-eye views, the
+        point-cloud files); False leaves them out (a recording for the TDM alone, as its tests use).
     """
     bars = progress_bars(progress)  # the stages' own tqdm bars
     started = time.perf_counter()
@@ -334,7 +337,8 @@ def render(scenario: Scenario, out_dir: Path, progress: bool | None = None, form
             t0 = time.perf_counter()
             ctx.counts.update(after_sensors(staged.path))
             wall["tdm"] = time.perf_counter() - t0
-        _write_derived(ctx, scenario, formats, progress)
+        if derived:
+            _write_derived(ctx, scenario, formats, progress)
         wall["total"] = time.perf_counter() - started
         manifest = manifest_now()
         with atomic_path(staged.path / MANIFEST) as tmp:

@@ -52,17 +52,20 @@ def write_scenario(tmp_path):
     return write
 
 
-def render_recording(scenario_path: Path, out: Path, duration_s: float, sensors=None, seed=None) -> Path:
+def render_recording(scenario_path: Path, out: Path, duration_s: float, sensors=None, seed=None,
+                     derived: bool = False) -> Path:
     """Render a scenario file into ``out`` for ``duration_s`` seconds; returns ``out``.
 
     The tdm package never imports raysim; its tests (and the benchmarks' tests) use raysim only
-    to make recordings with known truth, as a user would with the ``raysim render`` command.
+    to make recordings with known truth, as a user would with the ``raysim render`` command. The
+    files made from the recording's own (bag, map, bird's-eye views), which the TDM does not read,
+    are left out unless ``derived``.
     """
     from raysim.render import render
     from raysim.scenario import load_scenario, with_overrides
 
     scenario = with_overrides(load_scenario(Path(scenario_path)), duration_s, seed, sensors)
-    render(scenario, Path(out), progress=False)
+    render(scenario, Path(out), progress=False, derived=derived)
     return Path(out)
 
 

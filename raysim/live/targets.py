@@ -35,7 +35,7 @@ def prepare_working_recording(scenario: Scenario, folder: Path) -> None:
 
     enabled = scenario.sensors.enabled_names()
     known = tuple(name for name in ("ais", "nav") if name in enabled) or ("nav",)
-    render(with_overrides(scenario, sensors=known), folder, progress=False)
+    render(with_overrides(scenario, sensors=known), folder, progress=False, derived=False)
     (folder / "scenario.yaml").write_text(scenario_to_yaml(scenario), encoding="utf-8")  # every sensor's settings
     for sensor in ("lidar", "radar"):
         if sensor in enabled:

@@ -115,7 +115,10 @@ def test_a_failing_variant_is_recorded_and_the_batch_goes_on(tmp_path, capsys):
     (["--seeds", "0"], "--seeds: must be >= 1"),
     (["--scheduler", "tcp://127.0.0.1:9"], "--scheduler: cannot connect"),
 ])
-def test_bad_batches_give_one_line_and_exit_2_with_nothing_on_disk(tmp_path, capsys, extra, expect):
+def test_bad_batches_give_one_line_and_exit_2_with_nothing_on_disk(tmp_path, capsys, monkeypatch, extra, expect):
+    import raysim.batch
+
+    monkeypatch.setattr(raysim.batch, "SCHEDULER_TIMEOUT_S", 1.0)  # nothing listens on port 9: no need to wait 10 s
     scenario = tiny_scenario(tmp_path / "scenario")
     out = tmp_path / "out"
     assert main(["batch", str(scenario), "-o", str(out), *extra]) == 2

@@ -139,9 +139,14 @@ def test_every_ais_line_decodes_with_pyais_and_every_nav_line_with_pynmea2(sessi
     rx, _ = session
     ais = [p.decode("ascii") for p in rx["ais"].payloads]
     assert ais and all(line.startswith("!AIVDM") and line.endswith("\r\n") for line in ais)
-    for line in ais:
-        if line.split(",")[1] == "1":  # single-fragment messages (the multi-part ones need their partner)
-            assert pyais.decode(line.strip()).mmsi > 0
+    fragments = []
+    for line in ais:  # a multi-part message's fragments come one after another
+        fragments.append(line.strip())
+        count, number = line.split(",")[1:3]
+        if number == count:
+            assert pyais.decode(*fragments).mmsi > 0
+            fragments = []
+    assert not fragments
     nav = [p.decode("ascii").strip() for p in rx["nav"].payloads]
     kinds = {pynmea2.parse(line, check=True).sentence_type for line in nav}
     assert kinds == {"RMC", "GGA", "VTG", "ZDA", "HDT"}
