@@ -75,7 +75,8 @@ def main(argv=None) -> int:
         threading.Event().wait(0.5)  # the last datagrams in flight
         for r in rx.values():
             r.close()
-    rows, figures = [], {"duration_s": duration, "reached_s": result.reached_s}
+    rows, figures = [("send process scheduling", result.scheduling)], {"duration_s": duration, "reached_s": result.reached_s,
+                                                                       "scheduling": result.scheduling}
     for name in STREAMS:
         s = result.streams.get(name, {"sent": 0, "late": 0, "median_ms": 0.0, "p99_ms": 0.0, "max_ms": 0.0})
         lost = s["sent"] - rx[name].count

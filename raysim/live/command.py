@@ -77,6 +77,8 @@ def cmd_live(args, load) -> int:
     for name, s in result.streams.items():
         print(f"live: {name}: {s['sent']} sent, {s['late']} late (over 10 ms); lateness median {s['median_ms']:.2f} ms, "
               f"p99 {s['p99_ms']:.2f} ms, max {s['max_ms']:.2f} ms")
+    print(f"live: send process scheduling: {result.scheduling}" + ("" if result.scheduling == "SCHED_RR" else
+          " (real-time scheduling needs root or CAP_SYS_NICE; lateness is higher without it)"))
     ended = "interrupted" if result.interrupted else "done"
     print(f"live: {ended} at t = {result.reached_s:.1f} s" +
           (f"; own-ship feed went stale {result.stale_events} times" if result.stale_events else ""))

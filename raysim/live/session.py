@@ -9,7 +9,8 @@ the recording's manifest (``--record``).
 from __future__ import annotations
 
 import json
-import socket
+import multiprocessing
+import queue
 import sys
 import tempfile
 import threading
@@ -18,7 +19,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from raysim.live.navico import BEACON_ADDRESS, RADAR_MULTICAST, REPORT_ADDRESS, beacon, status_report
-from raysim.live.sender import LiveStream, Lateness, Producer, send_streams
+from raysim.live.sender import QUEUE_DEPTH, Producer
+from raysim.live.wire import summary, wire_main
 from raysim.live.streams import (ais_batches, announcements, lidar_data_batches, lidar_position_batches, nav_batches,
                                  radar_batches)
 from raysim.scenario import Scenario
@@ -26,15 +28,12 @@ from raysim.world import World
 
 __all__ = ["LivePorts", "LiveResult", "run_live", "PREROLL_TIMEOUT_S"]
 
-#: Longest wait for the first batch of every stream before the clock starts, s.
-PREROLL_TIMEOUT_S = 120.0
+#: Longest wait for the send process to start the clock, s (its own preroll is 120 s).
+PREROLL_TIMEOUT_S = 150.0
 #: A producer for a fed own ship renders no further than this ahead of the clock, s.
 FED_LEAD_S = 0.5
-#: The interpreter's thread switch interval during a session, s (default 5 ms): the send loop gets the
-#: interpreter back from the rendering threads this soon.
-SWITCH_INTERVAL_S = 0.0005
-#: Multicast TTL of the radar's spokes (1: this network segment only).
-MULTICAST_TTL = 1
+#: Longest wait for the send process's results after the end, s.
+RESULTS_TIMEOUT_S = 30.0
 
 
 @dataclass
@@ -60,11 +59,13 @@ class LiveResult:
     interrupted: bool
     streams: dict = field(default_factory=dict)
     stale_events: int = 0
+    scheduling: str = ""  # what the send process got from the scheduler (raysim.live.wire)
 
 
-def _streams(world: World, scene_factory, ports: LivePorts, stop: threading.Event, ready_before,
-             working: Path | None, on_targets=None) -> list[LiveStream]:
-    """A LiveStream per enabled sensor whose port is not 0 (and the TDM's, with a working recording)."""
+def _streams(world: World, scene_factory, ports: LivePorts, stop, working: Path | None,
+             on_targets=None) -> list[tuple[dict, object]]:
+    """Per enabled sensor whose port is not 0 (and the TDM's, with a working recording): its wire
+    description (:class:`raysim.live.wire.WireStream`'s fields) and its batch generator."""
     s = world.scenario
     enabled = set(s.sensors.enabled_names())
     out: list[tuple[str, tuple[str, int], object]] = []
@@ -100,8 +101,8 @@ def _streams(world: World, scene_factory, ports: LivePorts, stop: threading.Even
         out.append(("targets", (ports.dest, ports.targets), _tee(targets, on_targets) if on_targets else targets))
     # a sensor rendered only for the TDM or the Foxglove view (its port 0) sends nothing
     muted = {"lidar": not ports.lidar, "radar": not ports.radar, "targets": not ports.targets}
-    return [LiveStream(name, address, Producer(name, batches, stop, ready_before), muted=muted.get(name, False),
-                       report_behind=name != "targets") for name, address, batches in out]
+    return [(dict(name=name, address=address, muted=muted.get(name, False), report_behind=name != "targets",
+                  preroll=name != "targets"), batches) for name, address, batches in out]
 
 
 def _tee(batches, see):
@@ -127,13 +128,15 @@ def _scene_factory(world: World):
 
 
 class _Session:
-    """A session's parts: the world, the fed own ship, the working recording, the Foxglove view, the streams."""
+    """A session's parts: the world, the fed own ship, the working recording, the Foxglove view, the streams,
+    their producers (threads) and the send process."""
 
     def __init__(self, scenario: Scenario, ports: LivePorts, speed: float, ownship_port: int | None):
         self.scenario, self.ports, self.speed = scenario, ports, speed
         self.world = World(scenario)
         self.start_wall_s: float | None = None
-        self.stop = threading.Event()
+        self.mp = multiprocessing.get_context("spawn")  # a fresh interpreter: no locks inherited from threads
+        self.stop = self.mp.Event()
         self.feed = self.fed = self.view = self.working_dir = None
         ready_before = None
         if ownship_port is not None:
@@ -152,7 +155,13 @@ class _Session:
             self.view = FoxgloveView(ports.foxglove, working, self.clock, scenario.start_time.timestamp(),
                                      self.world.frame.to_local, self.stop)
             see = lambda t_s, records: self.view.targets.put((t_s, records))  # noqa: E731
-        self.streams = _streams(self.world, _scene_factory(self.world), ports, self.stop, ready_before, working, see)
+        streams = _streams(self.world, _scene_factory(self.world), ports, self.stop, working, see)
+        self.specs = [spec for spec, _ in streams]
+        self.queues = [self.mp.Queue(maxsize=QUEUE_DEPTH) for _ in streams]
+        for q in self.queues:  # batches left when a session is interrupted are dropped, not waited for at exit
+            q.cancel_join_thread()
+        self.producers = [Producer(spec["name"], batches, q, self.stop, ready_before)
+                          for (spec, batches), q in zip(streams, self.queues)]
 
     def clock(self) -> float:
         """Scenario time on the session's clock, s (0 until it starts)."""
@@ -174,37 +183,49 @@ class _Session:
         prepare_working_recording(self.scenario, working)
         return working
 
-    def run(self, log) -> LiveResult:
-        """Start the producers, wait for their first batches, send on the clock; stop everything at the end."""
-        sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-        if self.ports.radar_multicast:
-            sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, MULTICAST_TTL)
-        lateness, interrupted, reached = Lateness(), False, 0.0
-        switch_interval = sys.getswitchinterval()
-        sys.setswitchinterval(SWITCH_INTERVAL_S)
+    def run(self) -> LiveResult:
+        """Start the producers and the send process; wait for the end, Ctrl-C or SIGTERM; stop everything."""
+        started, start_at, results = self.mp.Event(), self.mp.Value("d", 0.0), self.mp.Queue()
+        wire = self.mp.Process(target=wire_main, name="raysim-live-wire", daemon=True,
+                               args=(self.specs, self.queues, self.speed, self.scenario.duration_s,
+                                     self.ports.radar_multicast, self.stop, started, start_at, results))
+        interrupted, outcome = False, None
         try:
-            for s in self.streams:
-                s.producer.start()
-            _preroll(self.streams, self.stop)
-            self.start_wall_s = time.perf_counter()
-            if self.view is not None:
-                self.view.start()
-            reached = send_streams(self.streams, sock, self.start_wall_s, self.speed, self.scenario.duration_s,
-                                   lateness, self.stop, log)
+            for p in self.producers:
+                p.start()
+            wire.start()
+            self._wait_for_start(wire, started, start_at)
+            outcome = _results(results, wire)
         except KeyboardInterrupt:
-            interrupted, reached = True, self.clock()
+            interrupted = True
+            self.stop.set()
+            outcome = _results(results, wire)
         finally:
-            sys.setswitchinterval(switch_interval)
-            sock.close()
+            self.stop.set()
             self.close()
-        stale = self.fed.stale_events if self.feed is not None else 0
-        return LiveResult(reached, interrupted, lateness.summary(), stale)
+            wire.join(timeout=5.0)
+        for p in self.producers:
+            if p.error is not None:
+                raise p.error
+        arrays, behind, reached, scheduling = outcome if outcome is not None else ({}, {}, self.clock(), "?")
+        stale = self.fed.stale_events if self.fed is not None else 0
+        return LiveResult(reached, interrupted, summary(arrays, behind), stale, scheduling)
+
+    def _wait_for_start(self, wire, started, start_at) -> None:
+        """Until the send process starts the clock: then the fed own ship and the Foxglove view follow it."""
+        deadline = time.perf_counter() + PREROLL_TIMEOUT_S
+        while not started.wait(0.05):
+            if not wire.is_alive() or self.stop.is_set() or time.perf_counter() > deadline:
+                return
+        self.start_wall_s = start_at.value
+        if self.view is not None:
+            self.view.start()
 
     def close(self) -> None:
         """Stop the producers, the own-ship feed and the Foxglove view; remove the working recording."""
         self.stop.set()
-        for s in self.streams:
-            s.producer.join(timeout=5.0)
+        for p in self.producers:
+            p.join(timeout=5.0)
         if self.feed is not None:
             self.feed.close()
         if self.view is not None:
@@ -213,6 +234,18 @@ class _Session:
             self.view.close()
         if self.working_dir is not None:
             self.working_dir.cleanup()
+
+
+def _results(results, wire):
+    """The send process's ``(lateness arrays, behind reports, reached s, scheduling)`` once it ends (None if it
+    died)."""
+    deadline = time.perf_counter() + RESULTS_TIMEOUT_S
+    while True:
+        try:
+            return results.get(timeout=0.2)
+        except queue.Empty:
+            if not wire.is_alive() and time.perf_counter() > deadline:
+                return None
 
 
 def run_live(scenario: Scenario, ports: LivePorts, speed: float = 1.0, ownship_port: int | None = None,
@@ -230,18 +263,4 @@ def run_live(scenario: Scenario, ports: LivePorts, speed: float = 1.0, ownship_p
         Listen on 127.0.0.1:port for the own ship's NMEA (GGA, HDT, VTG, PSXN,23).
     """
     session = _Session(scenario, ports, speed, ownship_port)
-    return session.run(log), session.world
-
-
-def _preroll(streams: list[LiveStream], stop: threading.Event) -> None:
-    """Wait until every stream has its first batch (or is over): the clock starts with all of them ready.
-
-    Not the TDM's targets: its first epoch waits for scans that end after it, which need the clock.
-    """
-    deadline = time.perf_counter() + PREROLL_TIMEOUT_S
-    while not stop.is_set() and time.perf_counter() < deadline:
-        if all(s.next_time() is not None or s.finished or not s.report_behind for s in streams):
-            return
-        time.sleep(0.01)
-    if not stop.is_set():
-        raise RuntimeError(f"live: streams not ready after {PREROLL_TIMEOUT_S:g} s")
+    return session.run(), session.world
