@@ -33,6 +33,10 @@ _SUBSAMPLE_RAYS = 2048
 """Rays sampled to estimate the static candidate fraction."""
 _OFFSET_GRID_M = 1024.0
 """The static scene's offset is snapped to this grid, metres."""
+NEAR_TABLE_LOOP_MAX_RUNS = 64
+"""Up to this many azimuth runs the near table is filled block by block; beyond, by one scatter."""
+NEAR_TABLE_SCATTER_MAX_CELLS = 4_000_000
+"""Largest number of (run, cell) pairs filled by one scatter (memory stays small); beyond, block by block."""
 
 
 @dataclass
@@ -128,7 +132,12 @@ class StaticPart:
         table = np.full((AZ_BINS, EL_BINS), np.inf, dtype=np.float32)
         cells = sphere_cells(st.sphere_centres, st.sphere_radii, batch.origin_centre, batch.spread_m)
         near = np.nextafter((cells.near_m * (1 - 1e-6)).astype(np.float32), np.float32(-np.inf))  # round down
-        for k, lo, hi, e0, e1 in zip(*cells.runs(np.arange(len(near)))):
+        runs = cells.runs(np.arange(len(near)))
+        area = (runs[2] - runs[1] + 1) * (runs[4] - runs[3] + 1)
+        if runs[0].size > NEAR_TABLE_LOOP_MAX_RUNS and int(area.sum()) <= NEAR_TABLE_SCATTER_MAX_CELLS:
+            _scatter_min(table, near, runs, area)  # many small blocks (land in tiles): one scatter
+            return table.reshape(-1)
+        for k, lo, hi, e0, e1 in zip(*runs):
             block = table[lo : hi + 1, e0 : e1 + 1]
             np.minimum(block, near[k], out=block)
         return table.reshape(-1)
@@ -229,6 +238,28 @@ class StaticPart:
         hits.primitive[j] = prim
         hits.material[j] = st.face_material[st.geometry_face_offset[g] + prim]
         hits.normal[j] = normal
+
+
+def _scatter_min(table: np.ndarray, near: np.ndarray, runs: tuple[np.ndarray, ...], area: np.ndarray) -> None:
+    """``table[lo:hi+1, e0:e1+1] = min(table, near[label])`` for every run at once (``np.minimum.at``).
+
+    Parameters
+    ----------
+    table : (AZ_BINS, EL_BINS) float32
+        Filled in place.
+    near : (K,) float32
+        Nearest distance per object, metres.
+    runs : tuple of (R,) int64
+        ``label, lo, hi, e0, e1`` (:meth:`SphereCells.runs`).
+    area : (R,) int64
+        Cells of each run's block.
+    """
+    label, lo, hi, e0, e1 = runs
+    n_el = e1 - e0 + 1
+    run = np.repeat(np.arange(label.size), area)
+    offset = np.arange(run.size) - np.repeat(np.cumsum(area) - area, area)
+    cell = (lo[run] + offset // n_el[run]) * EL_BINS + e0[run] + offset % n_el[run]
+    np.minimum.at(table.reshape(-1), cell, near[label[run]])
 
 
 def _static_results_part(

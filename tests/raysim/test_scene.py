@@ -429,3 +429,24 @@ def test_static_culling_matches_plain_cast(dense):
         sea = exp_id == SEA_ID
         np.testing.assert_array_equal(hits.normal[sea], np.tile([0, 0, 1], (sea.sum(), 1)))
         np.testing.assert_array_equal(hits.primitive[sea], -1)
+
+
+def test_the_near_table_of_many_static_objects_by_one_scatter_equals_block_by_block(monkeypatch):
+    """Land in tiles gives hundreds of static objects: their near table is filled by one scatter, to the same values."""
+    import raysim.scene.static as static
+    from raysim.scene.rays import RayBatch
+
+    rng = np.random.default_rng(5)
+    objects = []
+    for k in range(200):  # boxes around the origin, 30 m to 2 km out
+        r, a = rng.uniform(30.0, 2000.0), rng.uniform(0.0, 2 * np.pi)
+        mesh = trimesh.creation.box(extents=rng.uniform(2.0, 60.0, 3))
+        objects.append(make_object(k + 1, mesh, Stationary([r * np.sin(a), r * np.cos(a), 2.0])))
+    part = static.StaticPart.build(objects, nthreads=0, workers=1)
+    batch = RayBatch(np.zeros((4, 3)), np.tile([1.0, 0.0, 0.0], (4, 1)), np.zeros(4), None)
+    batch.origin_centre, batch.spread_m = np.array([3.0, -2.0, 4.0]), 12.0
+    scattered = part.near_table(batch)
+    monkeypatch.setattr(static, "NEAR_TABLE_LOOP_MAX_RUNS", 10**9)
+    blocks = part.near_table(batch)
+    assert np.isfinite(blocks).sum() > 1000
+    assert np.array_equal(scattered, blocks)
