@@ -153,10 +153,15 @@ class DetectionStream:
         if not self._jobs and not has_ais:
             raise RecordingError(str(rec), "(directory)", "holds no LiDAR, radar or AIS data to detect targets in")
 
-    def follow(self, jobs: Jobs) -> None:
+    def follow(self, jobs: Jobs, ownship: OwnshipTrack | None = None) -> None:
         """Take the scans from ``jobs`` instead of the recording's files (live mode: scans that arrive while
-        the stream runs; per sensor an iterator of ``(sensor, sweep path)`` in time order and the scan period, s)."""
+        the stream runs; per sensor an iterator of ``(sensor, sweep path)`` in time order and the scan period, s),
+        and the own ship from ``ownship`` if given (a track that grows while the stream runs; the front ends
+        must then run in this process, ``workers`` 0, to see it grow)."""
         self._jobs = dict(jobs)
+        if ownship is not None:
+            self.ownship = ownship
+            self._initargs = (ownship,) + self._initargs[1:]
 
     def events(self) -> Iterator[tuple[float, str, object]]:
         """(time s, sensor, Detections or AisReport) in time order (a scan at its last point's time)."""

@@ -63,7 +63,7 @@ class LiveResult:
 
 
 def _streams(world: World, scene_factory, ports: LivePorts, stop, working: Path | None,
-             on_targets=None) -> list[tuple[dict, object]]:
+             on_targets=None, fed=None) -> list[tuple[dict, object]]:
     """Per enabled sensor whose port is not 0 (and the TDM's, with a working recording): its wire
     description (:class:`raysim.live.wire.WireStream`'s fields) and its batch generator."""
     s = world.scenario
@@ -97,7 +97,7 @@ def _streams(world: World, scene_factory, ports: LivePorts, stop, working: Path 
     if working is not None:
         from raysim.live.targets import target_batches
 
-        targets = target_batches(working, done, stop)
+        targets = target_batches(working, done, stop, fed, world.frame)
         out.append(("targets", (ports.dest, ports.targets), _tee(targets, on_targets) if on_targets else targets))
     # a sensor rendered only for the TDM or the Foxglove view (its port 0) sends nothing
     muted = {"lidar": not ports.lidar, "radar": not ports.radar, "targets": not ports.targets}
@@ -155,7 +155,7 @@ class _Session:
             self.view = FoxgloveView(ports.foxglove, working, self.clock, scenario.start_time.timestamp(),
                                      self.world.frame.to_local, self.stop)
             see = lambda t_s, records: self.view.targets.put((t_s, records))  # noqa: E731
-        streams = _streams(self.world, _scene_factory(self.world), ports, self.stop, working, see)
+        streams = _streams(self.world, _scene_factory(self.world), ports, self.stop, working, see, self.fed)
         self.specs = [spec for spec, _ in streams]
         self.queues = [self.mp.Queue(maxsize=QUEUE_DEPTH) for _ in streams]
         for q in self.queues:  # batches left when a session is interrupted are dropped, not waited for at exit

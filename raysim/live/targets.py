@@ -58,7 +58,8 @@ def follow_sweeps(sensor: str, sweeps_dir: Path, done: threading.Event, stop: th
             time.sleep(FOLLOW_POLL_S)
 
 
-def target_batches(folder: Path, done: dict[str, threading.Event], stop: threading.Event) -> Iterator[Batch]:
+def target_batches(folder: Path, done: dict[str, threading.Event], stop: threading.Event, fed_motion=None,
+                   world_frame=None) -> Iterator[Batch]:
     """Each output epoch's detected targets (one JSON line a datagram) at the epoch's time, s.
 
     Parameters
@@ -68,17 +69,26 @@ def target_batches(folder: Path, done: dict[str, threading.Event], stop: threadi
     done : dict of str to threading.Event
         Per sensor with sweeps (``lidar``, ``radar``): set when its producer has written its last sweep.
     stop : threading.Event
+    fed_motion : raysim.live.ownship_in.FedMotion, optional
+        The fed own ship (``--ownship-in``): the TDM places its detections with it
+        (:class:`raysim.live.fed_track.FedOwnshipTrack`, in world frame ``world_frame``), its front ends in
+        this process so that they see the fixes as they arrive.
     """
     from tdm.detections import ReadStats
     from tdm.pipeline import DetectionStream, TdmConfig, targets_by_epoch
     from tdm.scans import DEFAULT_LIDAR_ROTATION_HZ, DEFAULT_RADAR_RPM, SECONDS_PER_MINUTE
 
-    config = TdmConfig.for_recording(folder, workers=TDM_WORKERS)
+    config = TdmConfig.for_recording(folder, workers=TDM_WORKERS if fed_motion is None else 0)
     stream = DetectionStream(folder, config, ReadStats())
+    ownship = None
+    if fed_motion is not None:
+        from raysim.live.fed_track import FedOwnshipTrack
+
+        ownship = FedOwnshipTrack(fed_motion, world_frame, stream.ownship.frame)
     periods = {"lidar": stream.description.lidar.period_s or 1.0 / DEFAULT_LIDAR_ROTATION_HZ,
                "radar": stream.description.radar.period_s or SECONDS_PER_MINUTE / DEFAULT_RADAR_RPM}
     stream.follow({sensor: (follow_sweeps(sensor, folder / sensor / "sweeps", event, stop), periods[sensor])
-                   for sensor, event in done.items()})
+                   for sensor, event in done.items()}, ownship=ownship)
     for t_s, records in targets_by_epoch(stream, config, stream.description.duration_s):
         if stop.is_set():
             return

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import datetime as dt
+import json
 import socket
 import threading
 import time
@@ -13,7 +14,7 @@ import yaml
 
 from raysim.cli import main
 from raysim.recording import nmea
-from tests.raysim.helpers import box_file, latlon, scenario
+from tests.raysim.helpers import FRAME, box_file, latlon, scenario
 from tests.raysim.live.receivers import Receiver
 
 WALL_NORTH_M = 30.0
@@ -66,15 +67,17 @@ def test_nmea_fed_to_ownship_in_moves_the_own_ship_and_the_wall_comes_nearer(tmp
                        "ais": {"enabled": False}}
     path = tmp_path / "wall.yaml"
     path.write_text(yaml.safe_dump(data))
-    lidar, port, stop = Receiver(), free_port(), threading.Event()
+    lidar, targets, port, stop = Receiver(), Receiver(), free_port(), threading.Event()
     feeder = threading.Thread(target=feed, args=(port, lidar, stop), daemon=True)
     feeder.start()
     try:
         code = main(["live", str(path), "--lidar-port", str(lidar.port), "--lidar-position-port", "0",
-                     "--nav-port", "0", "--ais-port", "0", "--radar-port", "0", "--ownship-in", str(port)])
+                     "--nav-port", "0", "--ais-port", "0", "--radar-port", "0", "--ownship-in", str(port),
+                     "--targets-port", str(targets.port)])
     finally:
         stop.set()
         lidar.close()
+        targets.close()
         feeder.join(timeout=2.0)
     assert code == 0
     ranges = forward_ranges(lidar.payloads)
@@ -82,6 +85,12 @@ def test_nmea_fed_to_ownship_in_moves_the_own_ship_and_the_wall_comes_nearer(tmp
     before, after = np.median(ranges[:10]), np.median(ranges[-10:])
     assert abs(before - WALL_NORTH_M) < 0.3  # the wall's face at 30 m from the origin
     assert abs((before - after) - MOVED_NORTH_M) < 0.1  # nearer by the distance the fed own ship moved
+    # the live TDM places the wall with the fed own ship: where it is (its face 30 m north), before and after the
+    # move; with the scenario's still own ship it would jump 5 m south when the ship moved
+    records = [json.loads(p) for p in targets.payloads]
+    last_t = max(r["t"] for r in records)
+    north = [FRAME.to_local(r["latitude"], r["longitude"])[1] for r in records if r["t"] == last_t]
+    assert north and min(abs(float(n) - WALL_NORTH_M) for n in north) < 2.0, north
 
 
 def test_sigterm_ends_a_live_session_cleanly_with_its_summary(tmp_path):
