@@ -10,7 +10,9 @@ the same in both processes), sends it by UDP and measures how late it left. A st
 batch is not there yet does not hold the others back: its payloads go as soon as they arrive and
 their lateness says so. Nothing is dropped.
 
-A batch on a queue is ``("batch", times_s, payloads)``; ``("done", None, None)`` ends a stream.
+A batch on a queue is ``("batch", times_s, payloads)``; ``("done", None, None)`` ends a stream. A reader
+thread per stream takes the batches off the session's queues into this process's own (one batch deep),
+so that the send loop never waits for a batch still crossing the pipe.
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ import queue
 import signal
 import socket
 import sys
+import threading
 import time
 from dataclasses import dataclass, field
 
@@ -37,6 +40,8 @@ END_GRACE_S = 5.0
 REPORT_EVERY_S = 1.0
 #: Longest wait for the first batch of every stream before the clock starts, s.
 PREROLL_TIMEOUT_S = 120.0
+#: Pause between the first batches of every stream being there and the clock's start, s.
+SETTLE_S = 0.2
 #: Multicast TTL (1: this network segment only).
 MULTICAST_TTL = 1
 
@@ -180,6 +185,28 @@ def _raise_priority() -> str:
         return "default"
 
 
+def _read(source, out: queue.Queue, stop) -> None:
+    """Move one stream's batches from the session's queue to this process's, ahead of the send loop.
+
+    A batch crosses the pipe from the session's feeder thread, which shares the renderers' interpreter:
+    reading it in the send loop would hold the loop until the last byte came (milliseconds for a radar
+    revolution of 1 MB). Here a thread waits for it, its interpreter released while it reads.
+    """
+    while not stop.is_set():
+        try:
+            item = source.get(timeout=0.1)
+        except queue.Empty:
+            continue
+        while not stop.is_set():
+            try:
+                out.put(item, timeout=0.1)
+                break
+            except queue.Full:
+                continue
+        if item[0] == "done":
+            return
+
+
 def wire_main(specs: list[dict], sources: list, speed: float, end_s: float, multicast: bool, stop, started,
               start_at, results) -> None:
     """The send process: preroll, then the loop; puts ``(lateness arrays, behind reports, reached s, scheduling)``
@@ -189,13 +216,18 @@ def wire_main(specs: list[dict], sources: list, speed: float, end_s: float, mult
     """
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     scheduling = _raise_priority()
-    streams = [WireStream(source=src, **spec) for spec, src in zip(specs, sources)]
+    local = [queue.Queue(maxsize=1) for _ in sources]
+    readers = [threading.Thread(target=_read, args=(src, out, stop), daemon=True) for src, out in zip(sources, local)]
+    for r in readers:
+        r.start()
+    streams = [WireStream(source=out, **spec) for spec, out in zip(specs, local)]
     sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
     if multicast:
         sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, MULTICAST_TTL)
     lateness, reached = Lateness(), 0.0
     try:
         if preroll(streams, stop):
+            time.sleep(SETTLE_S)  # the readers take the next batches off the pipes before the clock starts
             start_at.value = time.perf_counter()
             started.set()
             reached = send_streams(streams, sock, start_at.value, speed, end_s, lateness, stop)
