@@ -4,8 +4,10 @@ Foxglove's own schemas on the bag's topic names (docs/formats.md, rosbag/), so t
 docs/foxglove_layout.json find them: ``/lidar/points`` (PointCloud, each revolution in the
 ``lidar`` frame), ``/radar/image/compressed`` (the revolution's PPI as a PNG), ``/truth/objects``
 (SceneUpdate, a box per object in ``map``) and ``/truth/geojson`` at 1 Hz, ``/ownship/fix``
-(LocationFix, for the Map panel) at 1 Hz, and ``/tdm/markers`` and ``/tdm/geojson`` with each
-epoch's detected targets. Everything is logged at its scenario time on the session's clock,
+(LocationFix, for the Map panel) at 1 Hz, ``/tdm/markers`` and ``/tdm/geojson`` with each
+epoch's detected targets, and ``/tf`` (FrameTransforms: ``map`` -> ``base_link`` from the own ship's
+navigation, ``base_link`` -> ``lidar`` and ``radar`` from the mounts) at 10 Hz, so the 3D panel puts the
+cloud where the boxes are. Everything is logged at its scenario time on the session's clock,
 as it becomes due; the sweeps are read from the live working recording (:mod:`raysim.live.targets`).
 
 foxglove-sdk is the maintained implementation of the Foxglove WebSocket protocol and schemas; a
@@ -29,7 +31,9 @@ from raysim.recording.jsonl import every, truth_epochs
 __all__ = ["FoxgloveView", "TOPICS"]
 
 TOPICS = ("/lidar/points", "/radar/image/compressed", "/truth/objects", "/truth/geojson", "/ownship/fix",
-          "/tdm/markers", "/tdm/geojson")
+          "/tdm/markers", "/tdm/geojson", "/tf")
+#: Rate of the frame transforms map -> base_link (the own ship) and base_link -> lidar / radar (the mounts), Hz.
+TF_RATE_HZ = 10.0
 #: How often the view looks for what has become due, s.
 POLL_S = 0.05
 
@@ -56,10 +60,12 @@ class FoxgloveView(threading.Thread):
     to_local : callable
         ``(lat_deg, lon_deg) -> (east_m, north_m)`` of the world's local frame (the targets' boxes).
     stop : threading.Event
+    mounts : dict, optional
+        Sensor frame name -> (rotation (3, 3), translation (3,) m), sensor to body (``/tf``).
     """
 
     def __init__(self, port: int, folder: Path, clock: Callable[[], float], start_unix_s: float,
-                 to_local: Callable, stop: threading.Event):
+                 to_local: Callable, stop: threading.Event, mounts: dict | None = None):
         super().__init__(name="live-foxglove", daemon=True)
         import foxglove
 
@@ -67,6 +73,7 @@ class FoxgloveView(threading.Thread):
         self.port = self.server.port
         self.folder, self.clock, self.start_unix_s, self.stop = Path(folder), clock, start_unix_s, stop
         self.to_local = to_local
+        self.mounts = mounts or {}
         self.targets: queue.Queue = queue.Queue()
         self.error: BaseException | None = None
         self._channels()
@@ -82,6 +89,9 @@ class FoxgloveView(threading.Thread):
         self.fix = LocationFixChannel("/ownship/fix")
         self.tdm = SceneUpdateChannel("/tdm/markers")
         self.tdm_geo = GeoJsonChannel("/tdm/geojson")
+        from foxglove.channels import FrameTransformsChannel
+
+        self.tf = FrameTransformsChannel("/tf")
 
     def close(self) -> None:
         self.server.stop()
@@ -90,7 +100,7 @@ class FoxgloveView(threading.Thread):
         try:
             truth = truth_epochs(self.folder / "truth.jsonl", every(1.0))
             next_truth = next(truth, None)
-            own = self._ownship_rows()
+            own, next_fix = self._ownship_rows(), -math.inf
             sweeps = {"lidar": 0, "radar": 0}
             while not self.stop.is_set():
                 now = self.clock()
@@ -98,7 +108,11 @@ class FoxgloveView(threading.Thread):
                     self._log_truth(*next_truth)
                     next_truth = next(truth, None)
                 while own and own[0]["t"] <= now:
-                    self._log_fix(own.pop(0))
+                    row = own.pop(0)
+                    self._log_tf(row)
+                    if row["t"] >= next_fix:
+                        self._log_fix(row)
+                        next_fix = row["t"] + 1.0
                 for sensor in sweeps:
                     sweeps[sensor] += self._log_sweep(sensor, sweeps[sensor], now)
                 while not self.targets.empty():
@@ -115,7 +129,7 @@ class FoxgloveView(threading.Thread):
         rows, last = [], -math.inf
         for line in path.read_text(encoding="utf-8").splitlines():
             row = json.loads(line)
-            if row["t"] >= last + 1.0:  # 1 Hz for the map
+            if row["t"] >= last + 1.0 / TF_RATE_HZ - 1e-9:  # the transforms' rate (the map's fix: 1 Hz of them)
                 rows.append(row)
                 last = row["t"]
         return rows
@@ -126,6 +140,24 @@ class FoxgloveView(threading.Thread):
         self.fix.log(LocationFix(timestamp=_stamp(self.start_unix_s + row["t"]), frame_id="base_link",
                                  latitude=row["lat"], longitude=row["lon"], altitude=0.0,
                                  heading=math.radians(row["heading_deg"])), log_time=self._ns(row["t"]))
+
+    def _log_tf(self, row: dict) -> None:
+        from foxglove.messages import FrameTransform, FrameTransforms, Quaternion, Vector3
+
+        from raysim.recording.rosbag.msgs import quaternion_from_matrix, zyx_quaternions
+
+        stamp = _stamp(self.start_unix_s + row["t"])
+        q = zyx_quaternions(np.radians(90.0 - row["heading_deg"]), -np.radians(row["pitch_deg"]),
+                            np.radians(row["roll_deg"]))
+        transforms = [FrameTransform(timestamp=stamp, parent_frame_id="map", child_frame_id="base_link",
+                                     translation=Vector3(x=row["x"], y=row["y"], z=row["z"]),
+                                     rotation=Quaternion(x=q[0], y=q[1], z=q[2], w=q[3]))]
+        for name, (rot, trans) in self.mounts.items():
+            x, y, z, w = quaternion_from_matrix(rot)
+            transforms.append(FrameTransform(timestamp=stamp, parent_frame_id="base_link", child_frame_id=name,
+                                             translation=Vector3(x=float(trans[0]), y=float(trans[1]), z=float(trans[2])),
+                                             rotation=Quaternion(x=x, y=y, z=z, w=w)))
+        self.tf.log(FrameTransforms(transforms=transforms), log_time=self._ns(row["t"]))
 
     def _log_truth(self, t_s: float, rows: list[dict]) -> None:
         entities = [self._box(t_s, f"{r['kind']}/{r['id']}", r["x"], r["y"], r["heading_deg"],

@@ -30,8 +30,12 @@ __all__ = ["LivePorts", "LiveResult", "run_live", "PREROLL_TIMEOUT_S"]
 
 #: Longest wait for the send process to start the clock, s (its own preroll is 120 s).
 PREROLL_TIMEOUT_S = 150.0
-#: A producer for a fed own ship renders no further than this ahead of the clock, s.
-FED_LEAD_S = 0.5
+#: A producer for a fed own ship renders no further than this ahead of the clock, s (a radar sector renders
+#: in about 0.15 s, a LiDAR chunk in a few tens of ms).
+FED_LEAD_S = 0.3
+#: Sectors of a radar revolution rendered anew for a fed own ship (24 rpm: 0.5 s each): a sector's last spoke
+#: is then at most FED_LEAD_S + 0.5 s ahead of the clock, inside the fed pose's 1 s of extrapolation.
+FED_RADAR_SECTORS = 5
 #: Longest wait for the send process's results after the end, s.
 RESULTS_TIMEOUT_S = 30.0
 
@@ -89,7 +93,8 @@ def _streams(world: World, scene_factory, ports: LivePorts, stop, working: Path 
         done["radar"] = threading.Event()
         sweeps = working / "radar" / "sweeps" if working is not None else None
         out.append(("radar", address, radar_batches(RadarRenderer(world, scene_factory()), sweeps_dir=sweeps,
-                                                    done=done["radar"])))
+                                                    done=done["radar"],
+                                                    sectors=FED_RADAR_SECTORS if fed is not None else 1)))
     if "ais" in enabled and ports.ais:
         out.append(("ais", (ports.dest, ports.ais), ais_batches(world)))
     if "nav" in enabled and ports.nav:
@@ -152,8 +157,11 @@ class _Session:
         if ports.foxglove is not None:
             from raysim.live.foxglove_view import FoxgloveView
 
+            from groundfloor.frames import mount_transform
+
+            mounts = {name: mount_transform(getattr(scenario.sensors, name).mount) for name in ("lidar", "radar")}
             self.view = FoxgloveView(ports.foxglove, working, self.clock, scenario.start_time.timestamp(),
-                                     self.world.frame.to_local, self.stop)
+                                     self.world.frame.to_local, self.stop, mounts)
             see = lambda t_s, records: self.view.targets.put((t_s, records))  # noqa: E731
         streams = _streams(self.world, _scene_factory(self.world), ports, self.stop, working, see, self.fed)
         self.specs = [spec for spec, _ in streams]

@@ -91,22 +91,38 @@ def lidar_position_batches(renderer) -> Iterator[Batch]:
 
 
 def radar_batches(renderer, spokes_per_frame: int = SPOKES_PER_FRAME, sweeps_dir: Path | None = None,
-                  done: threading.Event | None = None) -> Iterator[Batch]:
-    """Spoke frames in the Navico Broadband 3G/4G format, a revolution a batch.
+                  done: threading.Event | None = None, sectors: int = 1) -> Iterator[Batch]:
+    """Spoke frames in the Navico Broadband 3G/4G format, a revolution (or a sector of one) a batch.
 
     A frame leaves when its last spoke has been received: at that spoke's time. With ``sweeps_dir`` each
     revolution's NPZ sweep is written there too (the live TDM reads them); ``done`` is set after the last.
+
+    With ``sectors`` > 1 (a fed own ship) the revolution is rendered anew for each of its sectors, just
+    before the sector is due, and the sector's spokes are taken from that render: their poses come from
+    the fixes received by then, not from a pose extrapolated over the whole revolution. The random
+    streams are named after the revolution, so the renders differ only by the own ship's poses; the
+    sweep written for the TDM is the sent spokes' levels.
     """
     s = renderer.spokes
     index = np.arange(s)
-    last = np.minimum(np.arange(0, s, spokes_per_frame) + spokes_per_frame - 1, s - 1)
+    starts = np.arange(0, s, spokes_per_frame)
+    last = np.minimum(starts + spokes_per_frame - 1, s - 1)
+    sector_of_frame = (starts * sectors) // s
     try:
         for rev in range(renderer.n_revolutions):
-            r = renderer.revolution(rev)
+            sent = None
+            for sector in range(sectors):
+                r = renderer.revolution(rev)
+                frames_here = np.flatnonzero(sector_of_frame == sector)
+                rows = slice(int(starts[frames_here[0]]), int(last[frames_here[-1]]) + 1)
+                sent = r.arrays() if sent is None else sent
+                for name in ("echo", "heading_deg"):  # what the own ship's poses change
+                    sent[name][rows] = getattr(r, name)[rows]
+                frames = spoke_frames(r.echo[rows], index[rows], s, r.heading_deg[rows], float(renderer.cfg.range_m),
+                                      spokes_per_frame)
+                yield Batch(np.asarray(r.time, np.float64)[last[frames_here]], frames)
             if sweeps_dir is not None:
-                write_sweep(sweeps_dir, rev, RADAR_SWEEP, r.arrays())
-            frames = spoke_frames(r.echo, index, s, r.heading_deg, float(renderer.cfg.range_m), spokes_per_frame)
-            yield Batch(np.asarray(r.time, np.float64)[last], frames)
+                write_sweep(sweeps_dir, rev, RADAR_SWEEP, sent)
     finally:
         if done is not None:
             done.set()

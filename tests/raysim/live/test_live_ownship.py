@@ -117,3 +117,66 @@ def test_sigterm_ends_a_live_session_cleanly_with_its_summary(tmp_path):
     assert proc.returncode == 0, err
     assert "live: interrupted at t = " in out
     assert "live: lidar: " in out and "Traceback" not in err
+
+
+WEST_WALL_M = 60.0
+CRAB_WEST_MPS = 4.0
+
+
+def crab_west(port: int, radar: Receiver, stop: threading.Event, track: list) -> None:
+    """Heading north, moving west at 4 m/s from 2.5 s after the first radar frame: GGA + HDT at 10 Hz."""
+    deadline = time.perf_counter() + 40.0
+    while not radar.datagrams and time.perf_counter() < deadline and not stop.is_set():
+        time.sleep(0.01)
+    first = time.perf_counter()
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        while not stop.is_set() and time.perf_counter() < deadline:
+            now = time.perf_counter()
+            west = CRAB_WEST_MPS * max(0.0, now - first - 2.5)
+            track.append((now, west))
+            lat, lon = latlon(-west, 0.0)
+            utc = dt.datetime.now(dt.timezone.utc)
+            for line in (nmea.gpgga(utc, lat, lon, 0.0), nmea.hehdt(0.0)):
+                s.sendto((line + "\r\n").encode("ascii"), ("127.0.0.1", port))
+            time.sleep(0.1)
+
+
+def test_a_fed_own_ship_moves_the_radar_within_a_revolution(tmp_path):
+    """The radar's spokes take the fed pose of their own time: the range to a wall abeam follows the own ship
+    as it closes, on the late spokes of a revolution too (a revolution rendered at its start would extrapolate
+    the pose over 2.5 s and hold it after 1 s: metres off at 4 m/s)."""
+    from tests.raysim.live.test_live import navico_spokes
+
+    wall = {"name": "wall", "kind": "mesh", "mesh": box_file(tmp_path, "wall", (200.0, 2.0, 10.0), (0.0, 0.0, 4.0)),
+            "position": latlon(-WEST_WALL_M - 1.0, 0.0), "heading_deg": 0.0}  # 200 m north-south, its face 60 m west
+    data = scenario(tmp_path, obstacles=[wall], duration=9.0)
+    data["sensors"] = {"lidar": {"enabled": False}, "ais": {"enabled": False},
+                       "radar": {"spokes": 512, "samples": 1024, "range_m": 463.0, "mount": {"z_m": 4.0}}}
+    path = tmp_path / "west.yaml"
+    path.write_text(yaml.safe_dump(data))
+    radar, port, stop, track = Receiver(), free_port(), threading.Event(), []
+    feeder = threading.Thread(target=crab_west, args=(port, radar, stop, track), daemon=True)
+    feeder.start()
+    try:
+        code = main(["live", str(path), "--radar-port", str(radar.port), "--nav-port", "0", "--ais-port", "0",
+                     "--lidar-port", "0", "--lidar-position-port", "0", "--ownship-in", str(port)])
+    finally:
+        stop.set()
+        radar.close()
+        feeder.join(timeout=2.0)
+    assert code == 0
+    fed_t, fed_west = np.array(track).T
+    seen = []  # (moved m, wall range m) on the spoke abeam to port, once a revolution
+    for arrival, frame in radar.datagrams:
+        for spoke in navico_spokes(frame):
+            lit = np.flatnonzero(spoke["samples"] >= 8)
+            if spoke["angle"] == 3072 and lit.size:  # abeam to port (270 deg from the bow)
+                # the frame (spokes 384-415) left with its last spoke, 31 spoke periods after this one
+                seen.append((float(np.interp(arrival - 31 * 2.5 / 512, fed_t, fed_west)), lit[0] * 463.0 / 1023))
+    still = [rng - WEST_WALL_M for moved, rng in seen if moved == 0.0]
+    moving = [rng - (WEST_WALL_M - moved) for moved, rng in seen if moved > 4.0]
+    assert still and len(moving) >= 2, seen  # at rest on the first revolution, closing in on two more
+    bias = still[0]  # the echo's leading edge against the face (range response, saturation), measured at rest
+    # within 2.5 m of where the fed track had the ship at each spoke's time (a revolution rendered at its start,
+    # its pose held 1 s past the latest fix: 5-7 m off at 4 m/s)
+    assert np.max(np.abs(np.array(moving) - bias)) < 2.5, (bias, seen)

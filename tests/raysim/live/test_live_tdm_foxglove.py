@@ -92,8 +92,8 @@ def test_the_live_tdm_sends_targets_and_foxglove_shows_the_session(tmp_path):
     assert all(0.0 < r["t"] <= DURATION_S for r in records)
     assert {"lidar"} <= {s for r in records for s in r["sources"]}  # the berg at 60 m, from the live sweeps
     topics = set(client.channels.values())
-    assert {"/lidar/points", "/radar/image/compressed", "/truth/objects", "/ownship/fix", "/tdm/markers"} <= topics
-    for topic in ("/lidar/points", "/ownship/fix", "/truth/objects", "/tdm/markers"):
+    assert {"/lidar/points", "/radar/image/compressed", "/truth/objects", "/ownship/fix", "/tdm/markers", "/tf"} <= topics
+    for topic in ("/lidar/points", "/ownship/fix", "/truth/objects", "/tdm/markers", "/tf"):
         assert client.messages.get(topic, 0) >= 1, topic
 
 
