@@ -69,6 +69,10 @@ def cmd_live(args, load) -> int:
     from raysim.scenario import with_overrides
 
     scenario = load(args)
+    if args.record is not None:  # refused before the session, not after it
+        from raysim.recording.staging import check_output_dir
+
+        check_output_dir(args.record, "--record")
     ports = LivePorts(args.dest, args.lidar_port, args.lidar_position_port, args.radar_port, args.ais_port,
                       args.nav_port, args.radar_multicast, args.targets_port, args.foxglove)
     print(f"live: {scenario.name}, {scenario.duration_s:g} s at {args.speed:g}x real time, to {args.dest}",

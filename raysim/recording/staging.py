@@ -23,12 +23,13 @@ from groundfloor.staging import (EXIT_INTERRUPTED, EXIT_TERMINATED, HOST_MARKER,
 from raysim.errors import InputError
 
 
-def check_output_dir(path: Path) -> None:
-    """Refuse an output directory that exists and is neither empty nor a raysim recording."""
+def check_output_dir(path: Path, option: str = "-o") -> None:
+    """Refuse an output directory (given by the command-line ``option``) that exists and is neither empty nor a
+    raysim recording."""
     if path.exists() and not path.is_dir():
-        raise InputError("command line", "-o", f"{path} exists and is not a directory")
+        raise InputError("command line", option, f"{path} exists and is not a directory")
     if path.is_dir() and any(path.iterdir()) and not (path / MANIFEST).is_file():
-        raise InputError("command line", "-o", f"{path} is not empty and holds no raysim recording (no {MANIFEST}); choose another directory")
+        raise InputError("command line", option, f"{path} is not empty and holds no raysim recording (no {MANIFEST}); choose another directory")
 
 
 class StagedDirectory(Staging):

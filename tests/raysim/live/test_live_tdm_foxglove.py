@@ -102,3 +102,15 @@ def test_a_bad_argument_is_one_line_and_exit_2(tmp_path, capsys, flag, value):
     assert main(["live", str(tiny_scenario(tmp_path / "tiny")), flag, value]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and value in err[0]
+
+
+def test_a_record_directory_that_is_no_recording_is_refused_before_the_session(tmp_path, capsys):
+    other = tmp_path / "other"
+    other.mkdir()
+    (other / "notes.txt").write_text("mine\n")
+    started = time.perf_counter()
+    assert main(["live", str(tiny_scenario(tmp_path / "tiny")), "--duration", "5", "--record", str(other)]) == 2
+    assert time.perf_counter() - started < 3.0  # no 5 s session first
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--record" in err[0] and "no raysim recording" in err[0]
+    assert sorted(p.name for p in other.iterdir()) == ["notes.txt"]
