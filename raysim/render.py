@@ -254,6 +254,44 @@ def _write_scenario_files(ctx: RenderContext, scenario: Scenario) -> None:
         ctx.counts[LAND] = write_land_geojson(scenario, land_ids, ctx.out_dir / LAND)
 
 
+def _render_sensors(ctx: RenderContext, scenario: Scenario, enabled, progress) -> tuple[list[str], list[str]]:
+    """Each enabled sensor's renderer (:data:`SENSOR_RENDERERS`) as a progress stage; (rendered, not available)."""
+    rendered, not_available = [], []
+    for name in enabled:
+        renderer = SENSOR_RENDERERS.get(name)
+        if renderer is None:
+            not_available.append(name)
+            continue
+        before = set(ctx.counts)
+        with stage(name, progress, _sensor_plan(scenario, name), bar=name != "ais") as step:  # AIS: no bar
+            renderer(ctx)
+            made = sorted(set(ctx.counts) - before)
+            step.done = ", ".join(f"{ctx.counts[k]} {k.split('/', 1)[-1]}" for k in made)
+        ctx.wall_time_s[name] = step.elapsed_s
+        rendered.append(name)
+    return rendered, not_available
+
+
+def _manifest(scenario: Scenario, world: World, enabled, rendered: list[str], not_available: list[str], counts: dict,
+              wall: dict) -> dict:
+    """manifest.json's content (docs/formats.md)."""
+    return {
+        "format": FORMAT,
+        "format_version": FORMAT_VERSION,
+        "scenario": scenario.name,
+        "seed": scenario.seed,
+        "start_time": schema.to_plain(scenario.start_time),
+        "duration_s": scenario.duration_s,
+        "sensors_enabled": list(enabled),
+        "sensors_rendered": rendered,
+        "sensors_not_available": not_available,
+        "objects": [{"id": o.object_id, "name": o.name, "kind": o.kind} for o in world.objects],
+        "counts": dict(sorted(counts.items())),
+        "versions": _versions(),
+        "wall_time_s": {k: round(v, 3) for k, v in wall.items()},
+    }
+
+
 def render(scenario: Scenario, out_dir: Path, progress: bool | None = None, formats: tuple[str, ...] = (),
            after_sensors: Callable[[Path], dict[str, int]] | None = None, own_ship_motion=None,
            extra_counts: dict[str, int] | None = None, derived: bool = True) -> RenderResult:
@@ -301,35 +339,10 @@ def render(scenario: Scenario, out_dir: Path, progress: bool | None = None, form
                 ctx.counts[f"{name}.jsonl"] = write(world, staged.path / f"{name}.jsonl", bars)
                 step.done = f"{ctx.counts[f'{name}.jsonl']} lines"
             wall[name] = step.elapsed_s
-        rendered, not_available = [], []
-        for name in enabled:
-            renderer = SENSOR_RENDERERS.get(name)
-            if renderer is None:
-                not_available.append(name)
-                continue
-            before = set(ctx.counts)
-            with stage(name, progress, _sensor_plan(scenario, name), bar=name != "ais") as step:  # AIS: no bar
-                renderer(ctx)
-                made = sorted(set(ctx.counts) - before)
-                step.done = ", ".join(f"{ctx.counts[k]} {k.split('/', 1)[-1]}" for k in made)
-            wall[name] = step.elapsed_s
-            rendered.append(name)
+        rendered, not_available = _render_sensors(ctx, scenario, enabled, progress)
+
         def manifest_now() -> dict:
-            return {
-                "format": FORMAT,
-                "format_version": FORMAT_VERSION,
-                "scenario": scenario.name,
-                "seed": scenario.seed,
-                "start_time": schema.to_plain(scenario.start_time),
-                "duration_s": scenario.duration_s,
-                "sensors_enabled": list(enabled),
-                "sensors_rendered": rendered,
-                "sensors_not_available": not_available,
-                "objects": [{"id": o.object_id, "name": o.name, "kind": o.kind} for o in world.objects],
-                "counts": dict(sorted(ctx.counts.items())),
-                "versions": _versions(),
-                "wall_time_s": {k: round(v, 3) for k, v in wall.items()},
-            }
+            return _manifest(scenario, world, enabled, rendered, not_available, ctx.counts, wall)
 
         if after_sensors is not None:
             with atomic_path(staged.path / MANIFEST) as tmp:

@@ -10,24 +10,21 @@ from pathlib import Path
 __all__ = ["add_live_parser", "cmd_live", "live_counts"]
 
 
-def _port(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a port number: {text!r}") from None
-    if not 0 <= value <= 65535:
-        raise argparse.ArgumentTypeError(f"port {value} is outside 0..65535")
-    return value
+def _bounded(kind, lo, hi, what: str):
+    """An argparse type: ``kind(text)`` within [lo, hi], else an error naming ``what``."""
+    def parse(text: str):
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"not a {what}: {text!r}") from None
+        if not lo <= value <= hi:
+            raise argparse.ArgumentTypeError(f"{what} {value:g} is outside {lo:g}..{hi:g}")
+        return value
+    return parse
 
 
-def _speed(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
-    if not 0.01 <= value <= 100.0:
-        raise argparse.ArgumentTypeError(f"--speed {value:g} is outside 0.01..100")
-    return value
+_port = _bounded(int, 0, 65535, "port")
+_speed = _bounded(float, 0.01, 100.0, "--speed value")
 
 
 def add_live_parser(sub, duration_type, seed_type) -> None:
