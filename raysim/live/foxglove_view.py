@@ -74,6 +74,7 @@ class FoxgloveView(threading.Thread):
         self.folder, self.clock, self.start_unix_s, self.stop = Path(folder), clock, start_unix_s, stop
         self.to_local = to_local
         self.mounts = mounts or {}
+        self._next: dict[str, tuple[int, float, dict]] = {}  # per sensor: the next sweep, read, not yet due
         self.targets: queue.Queue = queue.Queue()
         self.error: BaseException | None = None
         self._channels()
@@ -201,15 +202,22 @@ class FoxgloveView(threading.Thread):
                     log_time=self._ns(t_s))
 
     def _log_sweep(self, sensor: str, k: int, now_s: float) -> int:
-        """Log sweep ``k`` of ``sensor`` if its file exists and its last time has come; 1 if logged."""
-        path = self.folder / sensor / "sweeps" / f"{k:06d}.npz"
-        if not path.exists():
-            return 0
-        with np.load(path) as sweep:
-            arrays = {name: sweep[name] for name in sweep.files}
-        t_end = float(np.max(arrays["time"])) if arrays["time"].size else 0.0
+        """Log sweep ``k`` of ``sensor`` if its file exists and its last time has come; 1 if logged.
+
+        A sweep read before its time is kept (``self._next``), not read again at every poll.
+        """
+        held = self._next.get(sensor)
+        if held is None or held[0] != k:
+            path = self.folder / sensor / "sweeps" / f"{k:06d}.npz"
+            if not path.exists():
+                return 0
+            with np.load(path) as sweep:
+                arrays = {name: sweep[name] for name in sweep.files}
+            held = self._next[sensor] = (k, float(np.max(arrays["time"])) if arrays["time"].size else 0.0, arrays)
+        _, t_end, arrays = held
         if t_end > now_s:
             return 0
+        del self._next[sensor]
         (self._log_cloud if sensor == "lidar" else self._log_ppi)(t_end, arrays)
         return 1
 
