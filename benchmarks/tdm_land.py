@@ -98,7 +98,8 @@ def main(argv=None) -> int:
         spread(results[n]["false_target_distance_from_land_m"]) for n in SCENARIOS) + " | - |")
     intro = [machine_line("tdm_land", False), "",
              "Default configuration (`tdm run`, `tdm evaluate`) on scenarios/near_shore.yaml and "
-             "scenarios/busy_port.yaml (schematic land; docs/land.md). The criteria are those of docs/tdm.md, "
+             "scenarios/busy_port.yaml (near_shore's land schematic, busy_port's Erie Basin, Brooklyn, from NYC's "
+             "shoreline data; docs/land.md). The criteria are those of docs/tdm.md, "
              "stated for these scenarios whatever they are; the TDM was tuned on busy_open_sea only.", "",
              *lines]
     text = "\n".join(["# The TDM near land", "", *intro, ""])
