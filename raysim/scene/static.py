@@ -37,6 +37,11 @@ NEAR_TABLE_LOOP_MAX_RUNS = 64
 """Up to this many azimuth runs the near table is filled block by block; beyond, by one scatter."""
 NEAR_TABLE_SCATTER_MAX_CELLS = 4_000_000
 """Largest number of (run, cell) pairs filled by one scatter (memory stays small); beyond, block by block."""
+NEAR_TABLE_MARGIN_M = 50.0
+"""The far objects' near table is built for the origin box grown by this much, metres, and kept while later boxes
+stay inside the grown one."""
+NEAR_TABLE_FAR_M = 500.0
+"""Objects whose bounding sphere is this far from the grown origin box, metres, are far (their table is kept)."""
 
 
 @dataclass
@@ -60,6 +65,7 @@ class StaticPart:
     sphere_radii: np.ndarray  # (G,) float64
     nthreads: int = 0
     workers: int = 1
+    _near_cache: tuple | None = None  # grown box: centre (3,), spread m; far objects (G,) bool; their table or None
 
     @classmethod
     def build(cls, objects: Sequence[SceneObject], nthreads: int, workers: int) -> "StaticPart":
@@ -115,8 +121,17 @@ class StaticPart:
             workers=workers,
         )
 
-    def near_table(self, batch: RayBatch) -> np.ndarray:
-        """Nearest distance at which a static object can be met through each direction cell.
+    def near_table(self, batch: RayBatch) -> np.ndarray | None:
+        """Nearest distance at which a static object can be met through each direction cell, or None.
+
+        None when the origin box lies within reach of a static object's bounding sphere: that sphere covers every
+        cell at distance 0, so every ray is a candidate and the table is of no use (cast all).
+
+        The far objects' part of the table (spheres NEAR_TABLE_FAR_M or more from the box: a coast in tiles) is
+        built for the box grown by NEAR_TABLE_MARGIN_M and kept while later boxes stay inside the grown one (a
+        sensor on a moving ship). A table built for a larger box is conservative for a smaller one inside it: it
+        lets through a few more rays, which miss or hit beyond their limit, so the hits are the same. The other
+        objects' part is built for the box itself at every call, and the two are merged by their minimum.
 
         Parameters
         ----------
@@ -125,12 +140,34 @@ class StaticPart:
 
         Returns
         -------
-        (CELLS,) float32
+        (CELLS,) float32 or None
             Metres (rounded down); ``inf`` where no static object can be met.
         """
-        st = self
+        centre, spread = np.asarray(batch.origin_centre, dtype=np.float64), float(batch.spread_m)
+        reach = np.linalg.norm(self.sphere_centres - centre, axis=1) - self.sphere_radii
+        if np.any(reach <= spread):
+            return None
+        everything = np.ones(reach.size, dtype=bool)
+        if spread > NEAR_TABLE_MARGIN_M:
+            return self._build_near_table(everything, centre, spread)
+        cached = self._near_cache
+        if cached is None or np.linalg.norm(centre - cached[0]) + spread > cached[1]:
+            grown = spread + NEAR_TABLE_MARGIN_M
+            far = reach - grown >= NEAR_TABLE_FAR_M
+            cached = (centre.copy(), grown, far, self._build_near_table(far, centre, grown) if far.any() else None)
+            self._near_cache = cached
+        far, far_table = cached[2], cached[3]
+        if far_table is None:
+            return self._build_near_table(everything, centre, spread)
+        if far.all():
+            return far_table
+        return np.minimum(far_table, self._build_near_table(~far, centre, spread))
+
+    def _build_near_table(self, which: np.ndarray, origin_centre: np.ndarray, spread_m: float) -> np.ndarray:
+        """(CELLS,) float32: the near table of the objects ``which`` ((G,) bool) for origins within ``spread_m``
+        of ``origin_centre`` (metres)."""
         table = np.full((AZ_BINS, EL_BINS), np.inf, dtype=np.float32)
-        cells = sphere_cells(st.sphere_centres, st.sphere_radii, batch.origin_centre, batch.spread_m)
+        cells = sphere_cells(self.sphere_centres[which], self.sphere_radii[which], origin_centre, spread_m)
         near = np.nextafter((cells.near_m * (1 - 1e-6)).astype(np.float32), np.float32(-np.inf))  # round down
         runs = cells.runs(np.arange(len(near)))
         area = (runs[2] - runs[1] + 1) * (runs[4] - runs[3] + 1)

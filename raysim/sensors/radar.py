@@ -49,7 +49,7 @@ from raysim.sensors import radar_physics as phys
 from raysim.sensors import radar_receiver
 from raysim.sensors.carrier import CarrierScene
 from raysim.sensors.context import SensorContext
-from raysim.sensors.radar_beam import antenna_pattern, block_kernel, convolve_rows_sparse, range_kernel
+from raysim.sensors.radar_beam import antenna_pattern, block_kernel, convolve_cells, convolve_rows_sparse, range_kernel
 from raysim.sensors.radar_clutter import SeaClutter
 from raysim.sensors.radar_interference import Interference, reject
 from raysim.sensors.radar_rain import RainEchoes, RainField
@@ -254,6 +254,11 @@ class RadarRenderer:
         """Convolve (M, N) complex echoes (sparse: point echoes at the flat indices ``cells``, if known) along range
         with the range impulse response."""
         return convolve_rows_sparse(rows, self.range_kernel, cells)
+
+    def range_filter_cells(self, values: np.ndarray, cells: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
+        """:meth:`range_filter` of the (M, N) echoes that are ``values`` (Q,) complex at the flat indices ``cells``
+        (Q,) and zero elsewhere; returns (M, N) complex."""
+        return convolve_cells(values, cells, shape, self.range_kernel)
 
     def range_skirt(self, power_rows: np.ndarray) -> np.ndarray | None:
         """(M, B) incoherent range skirt (phase noise) of (M, N) echo powers in blocks of SKIRT_BLOCK samples.

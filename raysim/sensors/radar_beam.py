@@ -100,21 +100,42 @@ def convolve_rows_sparse(rows: np.ndarray, kernel: np.ndarray, nonzero: np.ndarr
     (M, N) array of the type of ``rows``
         ``out[m, n] = sum_k rows[m, n - k] kernel[k + L // 2]``, k from -L // 2 to L // 2.
     """
-    m, n = rows.shape
-    half = kernel.size // 2
     flat = np.flatnonzero(rows) if nonzero is None else np.asarray(nonzero)
+    return convolve_cells(rows.reshape(-1)[flat], flat, rows.shape, kernel)
+
+
+def convolve_cells(values: np.ndarray, flat: np.ndarray, shape: tuple[int, int], kernel: np.ndarray) -> np.ndarray:
+    """:func:`convolve_rows_sparse` of the (M, N) array that holds ``values`` at the flat indices ``flat``, else 0.
+
+    Parameters
+    ----------
+    values : (Q,) float or complex
+        The non-zero cells' values.
+    flat : (Q,) int
+        Their flat indices in the (M, N) array (distinct).
+    shape : (int, int)
+        M, N.
+    kernel : (L,) float
+        Centred kernel, L odd.
+
+    Returns
+    -------
+    (M, N) array of the type of ``values``
+    """
+    m, n = shape
+    half = kernel.size // 2
     cols = flat % n
     taps = np.arange(-half, half + 1)
     target = cols[:, None] + taps[None, :]  # (Q, L) column each tap lands on
     inside = (target >= 0) & (target < n)
     where = (flat[:, None] + taps[None, :])[inside]
-    values = (rows.reshape(-1)[flat][:, None] * kernel[None, :])[inside]
-    if np.iscomplexobj(rows):
-        out = np.empty(m * n, rows.dtype)
-        out.real = np.bincount(where, weights=values.real, minlength=m * n)
-        out.imag = np.bincount(where, weights=values.imag, minlength=m * n)
+    spread = (values[:, None] * kernel[None, :])[inside]
+    if np.iscomplexobj(values):
+        out = np.empty(m * n, values.dtype)
+        out.real = np.bincount(where, weights=spread.real, minlength=m * n)
+        out.imag = np.bincount(where, weights=spread.imag, minlength=m * n)
     else:
-        out = np.bincount(where, weights=values, minlength=m * n).astype(rows.dtype)
+        out = np.bincount(where, weights=spread, minlength=m * n).astype(values.dtype)
     return out.reshape(m, n)
 
 

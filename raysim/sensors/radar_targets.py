@@ -275,22 +275,23 @@ class TargetEchoes:
         -------
         rows : (R,) int64
             The spokes with an echo.
-        field : (R, N) complex64
+        cells : (Q,) int64
+            Increasing flat indices, in an (R, N) array of ``rows``' range samples, of the cells holding an echo.
+        values : (Q,) complex64
             Their summed amplitudes, sqrt(SNR) (through the radar equation at each echo's range).
         """
         N = self.r.samples
         bins = np.rint(range_m / self.r.dr).astype(np.int64)
         ok = bins < N
         rows, row_of = np.unique(spoke[ok], return_inverse=True)
-        flat = row_of * N + bins[ok]
+        cells, cell_of = np.unique(row_of * N + bins[ok], return_inverse=True)
         amp = amp[ok] * self.snr_amp[bins[ok]]  # sqrt(m^2) -> sqrt(SNR) through the radar equation at the echo's range
-        re = np.bincount(flat, weights=amp.real, minlength=rows.size * N)
-        im = np.bincount(flat, weights=amp.imag, minlength=rows.size * N)
-        field = np.empty(rows.size * N, np.complex64)
-        field.real, field.imag = re, im
-        return rows, field.reshape(rows.size, N), np.unique(flat)
+        values = np.empty(cells.size, np.complex64)
+        values.real = np.bincount(cell_of, weights=amp.real, minlength=cells.size)
+        values.imag = np.bincount(cell_of, weights=amp.imag, minlength=cells.size)
+        return rows, cells, values
 
-    def _add_skirt(self, power: np.ndarray, rows: np.ndarray, field: np.ndarray) -> None:
+    def _add_skirt(self, power: np.ndarray, rows: np.ndarray, cells: np.ndarray, values: np.ndarray) -> None:
         """Add the incoherent range skirt (phase noise) of the strong echoes, through the two-way power pattern.
 
         Only cells whose skirt can rise over INVISIBLE_SNR are spread (the skirt is -65 dB under its echo: echoes
@@ -303,19 +304,24 @@ class TargetEchoes:
         power : (S, N) float32
             SNR of the object echoes, added to in place.
         rows : (R,) int64
-            Spokes of ``field``'s rows.
-        field : (R, N) complex64
-            Summed amplitudes per spoke and range sample before the range response, sqrt(SNR).
+            Spokes of the echoes' rows.
+        cells : (Q,) int64
+            Increasing flat indices of the echo cells in the (R, N) array of ``rows``' range samples.
+        values : (Q,) complex64
+            Summed amplitudes of those cells before the range response, sqrt(SNR).
         """
         r = self.r
         if r.range_skirt_kernel is None:
             return
-        cell_power = field.real**2 + field.imag**2
-        strong = cell_power * np.float32(self._skirt_peak) > INVISIBLE_SNR
-        strong_rows = np.flatnonzero(strong.any(axis=1))
-        if strong_rows.size == 0:
+        N = r.samples
+        cell_power = values.real**2 + values.imag**2
+        strong = np.flatnonzero(cell_power * np.float32(self._skirt_peak) > INVISIBLE_SNR)
+        if strong.size == 0:
             return
-        skirt = r.range_skirt(np.where(strong[strong_rows], cell_power[strong_rows], np.float32(0.0)))  # (R', B)
+        strong_rows, row_of = np.unique(cells[strong] // N, return_inverse=True)
+        strong_power = np.zeros((strong_rows.size, N), np.float32)
+        strong_power[row_of, cells[strong] % N] = cell_power[strong]
+        skirt = r.range_skirt(strong_power)  # (R', B)
         S = r.spokes
         reach = np.flatnonzero(r.az_power_pattern * skirt.max() > INVISIBLE_SNR)  # spoke offsets that count
         spokes = rows[strong_rows]
@@ -331,17 +337,17 @@ class TargetEchoes:
                                  n=S, axis=0, workers=FFT_WORKERS)
         r.add_blocks(power, np.maximum(spread, 0.0).astype(np.float32))
 
-    def _beam(self, rows: np.ndarray, field: np.ndarray, cells: np.ndarray) -> np.ndarray | None:
+    def _beam(self, rows: np.ndarray, cells: np.ndarray, values: np.ndarray) -> np.ndarray | None:
         """Range impulse response and two-way voltage beam over spokes, then power through the radar equation.
 
         Parameters
         ----------
         rows : (R,) int64
-            Spokes of ``field``'s rows.
-        field : (R, N) complex64
-            Summed amplitudes per spoke and range sample, sqrt(m^2).
+            Spokes with an echo.
         cells : (Q,) int64
-            Flat indices of ``field``'s cells holding an echo (the rest are zero).
+            Increasing flat indices of the echo cells in the (R, N) array of ``rows``' range samples.
+        values : (Q,) complex64
+            Summed amplitudes of those cells, sqrt(SNR).
 
         Returns
         -------
@@ -353,8 +359,8 @@ class TargetEchoes:
         if rows.size == 0:
             return None
         power = np.zeros((S, N), np.float32)
-        self._add_skirt(power, rows, field)
-        field = r.range_filter(field, cells)
+        self._add_skirt(power, rows, cells, values)
+        field = r.range_filter_cells(values, cells, (rows.size, N))
         # range samples whose strongest echo, even at the beam's peak, stays under INVISIBLE_SNR: left out
         cols = np.flatnonzero((field.real**2 + field.imag**2).max(axis=0) > INVISIBLE_SNR)
         if cols.size:

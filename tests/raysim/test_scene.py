@@ -444,9 +444,57 @@ def test_the_near_table_of_many_static_objects_by_one_scatter_equals_block_by_bl
         objects.append(make_object(k + 1, mesh, Stationary([r * np.sin(a), r * np.cos(a), 2.0])))
     part = static.StaticPart.build(objects, nthreads=0, workers=1)
     batch = RayBatch(np.zeros((4, 3)), np.tile([1.0, 0.0, 0.0], (4, 1)), np.zeros(4), None)
-    batch.origin_centre, batch.spread_m = np.array([3.0, -2.0, 4.0]), 12.0
-    scattered = part.near_table(batch)
+    centre, spread = np.array([3.0, -2.0, 4.0]), 12.0
+    everything = np.ones(len(objects), dtype=bool)
+    scattered = part._build_near_table(everything, centre, spread)
     monkeypatch.setattr(static, "NEAR_TABLE_LOOP_MAX_RUNS", 10**9)
-    blocks = part.near_table(batch)
+    blocks = part._build_near_table(everything, centre, spread)
     assert np.isfinite(blocks).sum() > 1000
     assert np.array_equal(scattered, blocks)
+
+
+def _tiles_around(rng: np.random.Generator, n: int) -> list:
+    """``n`` static boxes 30 m to 2 km round the origin (land in tiles)."""
+    objects = []
+    for k in range(n):
+        r, a = rng.uniform(30.0, 2000.0), rng.uniform(0.0, 2 * np.pi)
+        mesh = trimesh.creation.box(extents=rng.uniform(2.0, 60.0, 3))
+        objects.append(make_object(k + 1, mesh, Stationary([r * np.sin(a), r * np.cos(a), 2.0])))
+    return objects
+
+
+def test_the_near_table_is_kept_while_the_origins_stay_in_its_grown_box_and_the_hits_do_not_change():
+    """A sensor moving within NEAR_TABLE_MARGIN_M reuses one table (white box) and gets the brute-force hits."""
+    import raysim.scene.static as static
+
+    objects = _tiles_around(np.random.default_rng(6), 150)
+    culled, plain = Scene(objects, sea=True), Scene(objects, sea=True, cull=False)
+    rng = np.random.default_rng(7)
+    d = rng.standard_normal((20_000, 3))
+    d[:, 2] = np.abs(d[:, 2]) * 0.05 - 0.01
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    tables = []
+    for step in range(6):  # 8 m a step: 40 m in all, inside the 50 m margin
+        o = np.tile([8.0 * step, 0.0, 3.0], (d.shape[0], 1)) + rng.uniform(-0.5, 0.5, (d.shape[0], 3))
+        t = np.zeros(d.shape[0])
+        a, b = culled.cast(o, d, t, max_range_m=1500.0), plain.cast(o, d, t, max_range_m=1500.0)
+        np.testing.assert_array_equal(a.object_id, b.object_id)
+        np.testing.assert_array_equal(a.range_m, b.range_m)
+        tables.append(culled._static._near_cache[3])
+        assert (b.object_id > 0).sum() > 100  # the tiles are hit
+    assert tables[0] is not None and culled._static._near_cache[2].sum() > 50  # most tiles are far
+    assert all(table is tables[0] for table in tables)  # built once for the 40 m
+    assert static.NEAR_TABLE_MARGIN_M == 50.0
+
+
+def test_the_near_table_is_skipped_when_the_origins_are_within_a_static_bounding_sphere():
+    """Rays from a coast (second bounces) start inside the tiles' spheres: every ray is a candidate, no table."""
+    from raysim.scene.rays import RayBatch
+
+    objects = _tiles_around(np.random.default_rng(8), 50)
+    part = Scene(objects, sea=True)._static
+    batch = RayBatch(np.zeros((4, 3)), np.tile([1.0, 0.0, 0.0], (4, 1)), np.zeros(4), None)
+    batch.origin_centre, batch.spread_m = part.sphere_centres[3].copy(), 1.0
+    assert part.near_table(batch) is None
+    batch.origin_centre = np.array([0.0, 0.0, 3.0])
+    assert part.near_table(batch) is not None
