@@ -30,6 +30,7 @@ Per revolution, from the hits of the fan of rays (:meth:`raysim.sensors.radar.Ra
 from __future__ import annotations
 
 import math
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import scipy.fft
@@ -291,8 +292,8 @@ class TargetEchoes:
         values.imag = np.bincount(cell_of, weights=amp.imag, minlength=cells.size)
         return rows, cells, values
 
-    def _add_skirt(self, power: np.ndarray, rows: np.ndarray, cells: np.ndarray, values: np.ndarray) -> None:
-        """Add the incoherent range skirt (phase noise) of the strong echoes, through the two-way power pattern.
+    def _skirt(self, rows: np.ndarray, cells: np.ndarray, values: np.ndarray):
+        """The incoherent range skirt (phase noise) of the strong echoes, through the two-way power pattern.
 
         Only cells whose skirt can rise over INVISIBLE_SNR are spread (the skirt is -65 dB under its echo: echoes
         over about 45 dB): along range by :meth:`RadarRenderer.range_skirt` (on blocks of samples), over spokes by one
@@ -301,23 +302,27 @@ class TargetEchoes:
 
         Parameters
         ----------
-        power : (S, N) float32
-            SNR of the object echoes, added to in place.
         rows : (R,) int64
             Spokes of the echoes' rows.
         cells : (Q,) int64
             Increasing flat indices of the echo cells in the (R, N) array of ``rows``' range samples.
         values : (Q,) complex64
             Summed amplitudes of those cells before the range response, sqrt(SNR).
+
+        Returns
+        -------
+        None, or blocks : (M, B) float32 and spokes : (M,) int or None
+            SNR to add per block of range samples (:meth:`RadarRenderer.add_blocks`) on the spokes ``spokes``
+            (None: all S spokes).
         """
         r = self.r
         if r.range_skirt_kernel is None:
-            return
+            return None
         N = r.samples
         cell_power = values.real**2 + values.imag**2
         strong = np.flatnonzero(cell_power * np.float32(self._skirt_peak) > INVISIBLE_SNR)
         if strong.size == 0:
-            return
+            return None
         strong_rows, row_of = np.unique(cells[strong] // N, return_inverse=True)
         strong_power = np.zeros((strong_rows.size, N), np.float32)
         strong_power[row_of, cells[strong] % N] = cell_power[strong]
@@ -328,14 +333,13 @@ class TargetEchoes:
         if spokes.size <= SKIRT_MATMUL_MAX_SPOKES:  # a few strong spokes: the main lobe's rows by a matrix product
             out = np.unique((spokes[:, None] + reach[None, :]) % S)
             pattern = r.az_power_pattern[(out[:, None] - spokes[None, :]) % S]  # (O, R') float32, >= 0
-            r.add_blocks(power, pattern @ skirt, out)
-            return
+            return pattern @ skirt, out
         # many (a coast on every spoke): one circular convolution over all spokes, on the blocks
         full = np.zeros((S, skirt.shape[1]), np.float32)
         full[spokes] = skirt
         spread = scipy.fft.irfft(scipy.fft.rfft(full, axis=0, workers=FFT_WORKERS) * self._az_power_pattern_f,
                                  n=S, axis=0, workers=FFT_WORKERS)
-        r.add_blocks(power, np.maximum(spread, 0.0).astype(np.float32))
+        return np.maximum(spread, 0.0).astype(np.float32), None
 
     def _beam(self, rows: np.ndarray, cells: np.ndarray, values: np.ndarray) -> np.ndarray | None:
         """Range impulse response and two-way voltage beam over spokes, then power through the radar equation.
@@ -359,17 +363,23 @@ class TargetEchoes:
         if rows.size == 0:
             return None
         power = np.zeros((S, N), np.float32)
-        self._add_skirt(power, rows, cells, values)
-        field = r.range_filter_cells(values, cells, (rows.size, N))
-        # range samples whose strongest echo, even at the beam's peak, stays under INVISIBLE_SNR: left out
-        cols = np.flatnonzero((field.real**2 + field.imag**2).max(axis=0) > INVISIBLE_SNR)
-        if cols.size:
-            full = np.zeros((S, cols.size), np.complex64)
-            full[rows] = field[:, cols]
-            spectrum = scipy.fft.fft(full, axis=0, workers=FFT_WORKERS, overwrite_x=True)
-            spectrum *= self._az_kernel_f
-            sub = scipy.fft.ifft(spectrum, axis=0, workers=FFT_WORKERS, overwrite_x=True)
-            _add_columns(power, cols, sub.real**2 + sub.imag**2)
+        # the range skirt on a thread of its own (FFTs that release the GIL) beside the range filter; the two sums
+        # meet in ``power`` after both, in either order the same bytes (two terms: IEEE addition commutes)
+        with ThreadPoolExecutor(max_workers=1, thread_name_prefix="radar-skirt") as pool:
+            skirt = pool.submit(self._skirt, rows, cells, values)
+            field = r.range_filter_cells(values, cells, (rows.size, N))
+            # range samples whose strongest echo, even at the beam's peak, stays under INVISIBLE_SNR: left out
+            cols = np.flatnonzero((field.real**2 + field.imag**2).max(axis=0) > INVISIBLE_SNR)
+            if cols.size:
+                full = np.zeros((S, cols.size), np.complex64)
+                full[rows] = field[:, cols]
+                spectrum = scipy.fft.fft(full, axis=0, workers=FFT_WORKERS, overwrite_x=True)
+                spectrum *= self._az_kernel_f
+                sub = scipy.fft.ifft(spectrum, axis=0, workers=FFT_WORKERS, overwrite_x=True)
+                _add_columns(power, cols, sub.real**2 + sub.imag**2)
+            spread = skirt.result()
+        if spread is not None:
+            r.add_blocks(power, *spread)
         return power
 
 
