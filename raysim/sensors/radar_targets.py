@@ -35,6 +35,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import scipy.fft
 
+from raysim.motion import Stationary
 from raysim.random_streams import stream
 from raysim.rcs.sea import sea_reflection_coefficient
 from raysim.scene import NO_HIT, SEA_ID
@@ -128,10 +129,15 @@ class TargetEchoes:
         for obj in np.unique(oid):
             idx = np.flatnonzero(oid == obj)
             motion = self.motion[int(obj)]
-            now = motion.poses(t_hit[idx])
-            later = motion.poses(t_hit[idx] + VELOCITY_STEP_S)
-            velocity[idx] = (later.position_m - now.position_m) / VELOCITY_STEP_S
-            body = now.to_body(point[idx])
+            if isinstance(motion, Stationary):  # land, buoys: one pose for all hits, no velocity (the same values)
+                now = motion.poses(np.zeros(1))
+                rotation = np.broadcast_to(now.rotation(), (idx.size, 3, 3))
+                body = np.einsum("nji,nj->ni", rotation, point[idx] - now.position_m)
+            else:
+                now = motion.poses(t_hit[idx])
+                later = motion.poses(t_hit[idx] + VELOCITY_STEP_S)
+                velocity[idx] = (later.position_m - now.position_m) / VELOCITY_STEP_S
+                body = now.to_body(point[idx])
             relief[idx] = RELIEF_PHASE_SCALE * 2.0 * math.pi * np.sum(
                 np.cos(body @ self.relief_k.T + self.relief_phase + 1.7 * float(obj)), axis=1)
         return velocity, relief
