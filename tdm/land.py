@@ -29,7 +29,7 @@ from tdm.detections import Detections
 from tdm.frames import EnuFrame
 from tdm.recording.land import ChartLand
 
-__all__ = ["DETECTION_MARGIN_M", "LandMask", "drop_on_land", "on_chart_land"]
+__all__ = ["DETECTION_MARGIN_M", "LandMask", "beam_margin_m", "drop_on_land", "on_chart_land"]
 
 #: Band around the land that counts as land for detections, m: one range resolution cell of the radar
 #: front end (2.5 m, :class:`tdm.frontend.radar_config.RadarFrontEndConfig`). Measured on a 10 s
@@ -91,11 +91,45 @@ class LandMask:
         return np.asarray(shapely.intersects_xy(self.geometry, east, north), dtype=bool)
 
 
-def drop_on_land(detections: Detections, mask: LandMask | None) -> Detections:
-    """``detections`` without those whose position lies in ``mask`` (all of them when ``mask`` is None)."""
+def beam_margin_m(range_m: np.ndarray, beam_fraction: float, beam_az_deg: float) -> np.ndarray:
+    """(N,) how far from land a radar plot at each range may be the land's own echo, smeared by the beam, m.
+
+    A coast face paints over the whole two-way beam as the antenna sweeps past it: its echo spreads
+    ``beam_fraction`` of the -3 dB beamwidth either side of the face's bearing, ``range sin(fraction theta3)``
+    across (beamwidth distortion: a radar cannot resolve what lies nearer the land than that; IMO
+    MSC.192(79) states the resolution of a radar as its beamwidth and range resolution). 0 at the default
+    fraction 0 (no margin).
+
+    Parameters
+    ----------
+    range_m : (N,) float
+        Ranges of the plots from the antenna, m.
+    beam_fraction : float
+        Fraction of the beamwidth either side (0.5: half the beam).
+    beam_az_deg : float
+        -3 dB one-way horizontal beamwidth, deg.
+    """
+    return np.asarray(range_m, dtype=float) * np.sin(np.radians(beam_fraction * beam_az_deg))
+
+
+def drop_on_land(detections: Detections, mask: LandMask | None, beam_fraction: float = 0.0,
+                 beam_az_deg: float = 0.0) -> Detections:
+    """``detections`` without those whose position lies in ``mask`` (all of them when ``mask`` is None).
+
+    With ``beam_fraction`` > 0 (radar plots), a detection is also dropped when it lies within
+    :func:`beam_margin_m` of the mask: the land's echo smeared by the beam, not a target that can be told
+    from it.
+    """
     if mask is None or len(detections) == 0:
         return detections
-    keep = ~mask.contains(detections.position_m[:, 0], detections.position_m[:, 1])
+    east, north = detections.position_m[:, 0], detections.position_m[:, 1]
+    keep = ~mask.contains(east, north)
+    if beam_fraction > 0.0 and keep.any():
+        margin = beam_margin_m(detections.range_m, beam_fraction, beam_az_deg)
+        near = np.flatnonzero(keep & (margin > 0.0))
+        if near.size:
+            distance = shapely.distance(mask.geometry, shapely.points(east[near], north[near]))
+            keep[near[distance <= margin[near]]] = False
     if keep.all():
         return detections
     n = len(detections)

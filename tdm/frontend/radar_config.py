@@ -114,6 +114,12 @@ class RadarFrontEndConfig:
         truth centres 0.5-1.5) the plots' real scatter (about 2 m on the Table 3.2 vessel) was
         reported as 10 m and the radar tracks lagged every turn; 0.25 halves their heading error
         (benchmarks/results/thesis_table32.md).
+    land_beam_fraction : float
+        With a chart (the recording's land), plots within ``range sin(land_beam_fraction beam_az_deg)``
+        of the land are dropped as the land's own echo smeared by the beam (:func:`tdm.land.beam_margin_m`).
+        Default 0.5: half the -3 dB beamwidth either side of a coast face, out to where the one-way pattern is
+        3 dB (two-way 6 dB) under its peak (a radar's azimuth resolution is its beamwidth); 0 turns it off.
+        Not fitted to any scenario: the figure is the beam's.
     range_scale_m, spokes, samples : float, int, int or None
         The sweep geometry the configuration is for (scenario ``sensors.radar``); when set,
         :func:`radar_detections` checks each sweep against it.
@@ -147,6 +153,7 @@ class RadarFrontEndConfig:
     blanking_m: float = 3.0
     bearing_sigma_beam_fraction: float = 0.15
     extent_sigma_fraction: float = 0.25
+    land_beam_fraction: float = 0.5
     range_scale_m: float | None = None
     spokes: int | None = None
     samples: int | None = None

@@ -15,7 +15,7 @@ from tdm.cli import main as tdm_main
 from tdm.detections import Detections
 from tdm.evaluate import evaluate
 from tdm.frames import EnuFrame
-from tdm.land import DETECTION_MARGIN_M, LandMask, drop_on_land, on_chart_land
+from tdm.land import DETECTION_MARGIN_M, LandMask, beam_margin_m, drop_on_land, on_chart_land
 from tdm.recording.land import ChartLand, read_land
 
 from .conftest import render_recording
@@ -122,6 +122,21 @@ def test_the_mask_drops_a_plot_on_land_and_keeps_one_at_sea():
     chart = LandMask(land, frame, 0.0)  # the output's test: the land itself
     assert chart.contains([0.0, 0.0, 0.0], [59.0, 60.01, 61.0]).tolist() == [False, True, True]
     assert drop_on_land(dets, None) is dets
+
+
+def test_radar_plots_within_half_a_beam_of_a_far_coast_are_dropped_and_near_ones_kept():
+    """A coast face's echo smears over the beam: at 1 km half of a 5.2 deg beam is 45 m across, at 50 m 2.3 m."""
+    frame = EnuFrame(LAT0, LON0)
+    far_coast = [(-300.0, 1000.0), (300.0, 1000.0), (300.0, 1200.0), (-300.0, 1200.0)]
+    land = ChartLand(tuple(_polygons(land_geojson(far_coast, frame)) + _polygons(land_geojson(ISLAND_XY_M, frame))),
+                     Path("land.geojson"))
+    mask = LandMask(land, frame, DETECTION_MARGIN_M)
+    assert beam_margin_m(np.array([1000.0]), 0.5, 5.2)[0] == pytest.approx(1000.0 * np.sin(np.radians(2.6)))
+    # 30 m off the far coast (inside 43.7 m + 2.5 m), 60 m off it (outside), 5 m off the near island's face at 55 m
+    dets = detections_at([(0.0, 970.0), (0.0, 940.0), (0.0, 52.0)])
+    kept = drop_on_land(dets, mask, beam_fraction=0.5, beam_az_deg=5.2)
+    assert kept.position_m.tolist() == [[0.0, 940.0], [0.0, 52.0]]
+    assert len(drop_on_land(dets, mask)) == 3  # without the beam: all three are at sea
 
 
 def _polygons(collection: dict):
