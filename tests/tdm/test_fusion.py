@@ -28,6 +28,21 @@ def test_fusion_of_courses_across_north():
     assert np.degrees(ekf.wrap_pi(x[ekf.PSI])) == pytest.approx(1.0)
 
 
+@pytest.mark.parametrize("rule", ["simple", "ci"])
+def test_a_track_with_its_speed_negative_and_its_course_reversed_fuses_as_the_same_motion(rule):
+    """(psi, u) and (psi + pi, -u) are one motion: fused, position and velocity stay those of both tracks."""
+    p = np.array([[4.0, 0.5, 0.3, 0.4, 0.0, 0.0], [0.5, 5.0, 0.2, 0.6, 0.0, 0.0], [0.3, 0.2, 0.05, 0.1, 0.0, 0.0],
+                  [0.4, 0.6, 0.1, 0.5, 0.0, 0.0], [0.0, 0.0, 0.0, 0.0, 1e-4, 0.0], [0.0, 0.0, 0.0, 0.0, 0.0, 100.0]])
+    ahead = np.array([284.0, 219.0, np.radians(181.0), 2.6, 0.0, 20.0])
+    reversed_ = ahead.copy()
+    reversed_[ekf.PSI], reversed_[ekf.U] = np.radians(1.0), -2.6
+    flip = np.diag([1.0, 1.0, 1.0, -1.0, 1.0, 1.0])
+    x, pf = fuse(np.array([ahead, reversed_]), np.array([p, flip @ p @ flip]), rule)
+    assert x[:2] == pytest.approx(ahead[:2], abs=1e-9)
+    assert ekf.velocity_en(x) == pytest.approx(ekf.velocity_en(ahead), abs=1e-9)
+    assert np.all(np.linalg.eigvalsh(pf) > 0)
+
+
 def test_covariance_intersection_stays_wider_than_simple_fusion():
     p1, p2 = np.diag([1.0, 4.0, 1, 1, 1, 1]), np.diag([4.0, 1.0, 1, 1, 1, 1])
     xs = np.zeros((2, 6))
