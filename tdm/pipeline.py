@@ -116,7 +116,8 @@ class _Tracking:
         self.ais.expire(t_out)
         by_sensor = {s: tr.confirmed_tracks() for s, tr in self.trackers.items()}
         by_sensor["ais"] = self.ais.confirmed_tracks()
-        for estimate in self.fuser.step(t_out, by_sensor):
+        own = self.ownship.position_m(np.array([t_out]))[0, :2]
+        for estimate in self.fuser.step(t_out, by_sensor, own):
             tgt = estimate.target
             if self.on_land(estimate.x):
                 continue

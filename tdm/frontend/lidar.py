@@ -279,7 +279,9 @@ def lidar_clusters(sweep: dict[str, np.ndarray], track: OwnshipTrack, mount: Mou
     fp = _footprints(enu, t, label, n_cells)
     sensor_enu = track.sensor_to_enu(np.zeros((k, 3)), fp.mean_t if config.deskew else np.full(k, scan_time_s), mount)
     if config.centre == "outline":
-        centre_e, centre_n = _outline_centres(enu, label, n_cells, fp, sensor_enu)
+        depth_fraction = np.where(fp.length_m < config.hidden_depth_max_elongation * fp.width_m,
+                                  config.hidden_depth_fraction, 0.0)
+        centre_e, centre_n = _outline_centres(enu, label, n_cells, fp, sensor_enu, depth_fraction)
     else:
         centre_e, centre_n = fp.mean_e, fp.mean_n
     los_e = centre_e - sensor_enu[:, 0]
@@ -414,9 +416,11 @@ def _footprints(enu: np.ndarray, t: np.ndarray, label: np.ndarray, n_cells: np.n
 
 
 def _outline_centres(enu: np.ndarray, label: np.ndarray, n_cells: np.ndarray, fp: _Footprint,
-                     sensor_enu: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+                     sensor_enu: np.ndarray, depth_fraction: np.ndarray | float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """(k,) east and north of each cluster's centre, m: the midpoint of its two outline points, farthest
-    left and right across the line of sight from the sensor to the points' mean (step 7)."""
+    left and right across the line of sight from the sensor to the points' mean (step 7), moved
+    ``depth_fraction`` (k,) of half the distance between them further along the line of sight (the depth
+    the sensor does not see)."""
     los_angle = np.arctan2(fp.mean_n - sensor_enu[:, 1], fp.mean_e - sensor_enu[:, 0])
     u_e, u_n = np.cos(los_angle), np.sin(los_angle)
     rel_e = enu[:, 0] - sensor_enu[label, 0]
@@ -426,8 +430,8 @@ def _outline_centres(enu: np.ndarray, label: np.ndarray, n_cells: np.ndarray, fp
     by_cross = np.lexsort((cross, label))
     left = by_cross[fp.starts]
     right = by_cross[fp.starts + n_cells - 1]
-    centre_depth = 0.5 * (depth[left] + depth[right])
     centre_cross = 0.5 * (cross[left] + cross[right])
+    centre_depth = 0.5 * (depth[left] + depth[right]) + depth_fraction * 0.5 * (cross[right] - cross[left])
     centre_e = sensor_enu[:, 0] + centre_depth * u_e - centre_cross * u_n
     centre_n = sensor_enu[:, 1] + centre_depth * u_n + centre_cross * u_e
     return centre_e, centre_n

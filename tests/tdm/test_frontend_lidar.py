@@ -110,6 +110,20 @@ def test_the_outline_centre_of_a_box_at_an_angle_is_its_centre_and_the_mean_is_s
     assert np.linalg.norm(mean.position_m[0] - truth) > 1.0
 
 
+def test_a_compact_cluster_is_put_its_hidden_depth_behind_its_outline_and_a_long_wall_is_not():
+    """An 8 m square block turned 45 deg, 30 m north, shows two faces in a V, 11.3 m across and 5.7 m deep: its
+    outline midpoint (the side corners') lies at 30 m; the hidden-depth fraction f puts it f x 5.66 m (half the
+    width across the line of sight) further along it. A wall (length over width far over 3) is not moved."""
+    block = [(30.0, 0.0, 8.0, 8.0, 45.0, 5.0)]
+    outline, behind = detect(block, hidden_depth_fraction=0.0), detect(block)
+    assert outline.position_m[0] == pytest.approx([0.0, 30.0], abs=0.2)
+    fraction = LidarFrontEndConfig().hidden_depth_fraction
+    assert fraction > 0.0
+    assert behind.position_m[0] == pytest.approx([0.0, 30.0 + fraction * 4.0 * math.sqrt(2.0)], abs=0.2)
+    wall = [(30.0, 0.0, 10.0, 0.3, 90.0, 6.0)]
+    assert detect(wall).position_m[0] == pytest.approx(detect(wall, hidden_depth_fraction=0.0).position_m[0])
+
+
 def test_walls_farther_apart_than_the_tolerance_are_two_clusters_closer_are_one():
     def walls(gap_m):
         return [(20.0, 3.0 + gap_m / 2, 6.0, 0.3, 90.0, 5.0), (20.0, -3.0 - gap_m / 2, 6.0, 0.3, 90.0, 5.0)]

@@ -59,6 +59,27 @@ def make_track(track_id, sensor, east, north, var=4.0, t=0.0, mmsi=None):
     return Track(track_id, sensor, x, p, t, t, t, confirmed=True, mmsi=mmsi)
 
 
+def test_a_still_targets_radar_track_is_put_its_hidden_depth_behind_the_face_along_the_line_of_sight():
+    """A berg's radar track 500 m north of the own ship, 12 m long: reported 0.7 x 12 m farther north once the
+    target is still (an iceberg); a vessel's, or a track with AIS, as it is."""
+    fuser = Fuser(FusionConfig())
+    radar = make_track(1, "radar", 0.0, 500.0)
+    radar.length_m = 12.0
+    own = np.array([0.0, 0.0])
+    (first,) = fuser.step(0.0, {"radar": [radar]}, own)
+    assert first.x[:2] == pytest.approx([0.0, 500.0])  # not yet known to be still
+    first.target.descriptor = "iceberg"
+    (still,) = fuser.step(1.0, {"radar": [radar]}, own)
+    depth = FusionConfig().radar_hidden_depth_fraction * 12.0
+    assert depth > 0.0 and still.x[:2] == pytest.approx([0.0, 500.0 + depth])
+    assert radar.x[:2] == pytest.approx([0.0, 500.0])  # the track itself is untouched
+    (no_own,) = fuser.step(2.0, {"radar": [radar]})
+    assert no_own.x[:2] == pytest.approx([0.0, 500.0])
+    still.target.descriptor = "vessel"
+    (vessel,) = fuser.step(3.0, {"radar": [radar]}, own)
+    assert vessel.x[:2] == pytest.approx([0.0, 500.0])
+
+
 def test_tracks_of_one_object_share_a_target_and_ids_stay_stable():
     fuser = Fuser(FusionConfig())
     radar = [make_track(1, "radar", 0.0, 0.0, var=25.0), make_track(2, "radar", 500.0, 0.0, var=25.0)]
