@@ -12,7 +12,8 @@ render`` with every sensor and without the bag and pictures (``render(derived=Fa
 read them) into ``WORK/<scenario>_<seed>``, ``tdm run`` and ``tdm evaluate`` with the default
 configuration; the run's metrics.json is kept in ``WORK/metrics/``, the sensors' files are deleted
 unless the seed is one of ``--keep-seeds`` (a 300 s recording is about 2 GB); a run whose metrics are there
-is not done again (a stopped benchmark goes on where it stopped). ``--rerun``: run the TDM and evaluate
+is not done again and a kept recording is not rendered again (a stopped benchmark goes on where it
+stopped). ``--rerun``: run the TDM and evaluate
 again on the kept recordings (after a TDM change) and report those runs only.
 
 The criteria (issue 22, "Done when"), per run:
@@ -118,7 +119,7 @@ def one_run(scenario: str, seed: int, duration_s: float, work: Path, keep: bool,
         return None  # not kept: its metrics are of the TDM before the change
     if not rerun and metrics_path.is_file():
         return json.loads(metrics_path.read_text())
-    if not rerun:
+    if not (recording / "manifest.json").is_file():  # a kept recording is not rendered again
         s = with_overrides(load_scenario(ROOT / "scenarios" / f"{scenario}.yaml"), seed=seed, duration_s=duration_s)
         render(s, recording, progress=False, derived=False)
     run_tdm(recording, recording / "tdm", TdmConfig.for_recording(recording))
