@@ -99,8 +99,13 @@ def run_criteria(metrics: dict, closest: dict[str, float]) -> dict:
         "id_switches_max": metrics["id_switches_max_per_object"],
         "false_targets_per_min": metrics["false_targets_per_min"],
         "nees_fraction_in_95": metrics["nees_fraction_in_95"],
-        "nees_fraction_in_95_per_sensor": {s: m.get("nees_fraction_in_95") for s, m in metrics["per_sensor"].items()},
         "gospa_m": metrics.get("gospa_m"),
+        "gospa_within_lidar_c10_m": metrics.get("gospa_within_lidar_range_c10_m"),
+        "latency_from_first_in_range_max_s": max(
+            (o["latency_from_first_in_range_s"] for o in near if o["latency_from_first_in_range_s"] is not None),
+            default=None),
+        "cog_rmse_deg": metrics.get("cog_rmse_deg"),
+        "nees_fraction_in_95_per_sensor": {s: m.get("nees_fraction_in_95") for s, m in metrics["per_sensor"].items()},
     }
 
 
@@ -165,11 +170,15 @@ def report(runs: list[dict], scenarios: list[str], seeds: list[int], duration_s:
                          f"**{sum(judged)}/{len(judged)}**" if judged else f"{middle}; -")
         tag = " (tuned)" if scenario == TUNED else ""
         lines.append(f"| {scenario}{tag}, {len(mine)} seeds | " + " | ".join(cells) + " |")
-    per_run = ["| scenario | seed | " + " | ".join(key for key, *_ in CRITERIA) + " | missed within 1.5 km |",
-               "|---|---:|" + "---:|" * len(CRITERIA) + "---|"]
+    extra = ("latency_from_first_in_range_max_s", "gospa_m", "gospa_within_lidar_c10_m", "cog_rmse_deg")
+    per_run = ["| scenario | seed | " + " | ".join(key for key, *_ in CRITERIA) + " | " + " | ".join(extra)
+               + " | NEES in 95 % per sensor | missed within 1.5 km |",
+               "|---|---:|" + "---:|" * (len(CRITERIA) + len(extra)) + "---|---|"]
     for r in runs:
+        sensors = ", ".join(f"{s} {_fmt(v)}" for s, v in sorted(r.get("nees_fraction_in_95_per_sensor", {}).items()))
         per_run.append(f"| {r['scenario']} | {r['seed']} | " + " | ".join(_fmt(r[key]) for key, *_ in CRITERIA)
-                       + f" | {', '.join(r['missed_names']) or '-'} |")
+                       + " | " + " | ".join(_fmt(r.get(key)) for key in extra)
+                       + f" | {sensors} | {', '.join(r['missed_names']) or '-'} |")
     intro = [machine_line("tdm_heldout", False), "",
              f"Default TDM configuration, tuned on {TUNED} only; every scenario rendered for {duration_s:g} s with "
              f"seeds {seeds[0]}-{seeds[-1]} (every sensor). A cell: the median over the seeds (min-max), then "

@@ -74,6 +74,7 @@ def _fmt(value, digits: int = 2) -> str:
 _TABLE_ROWS = (
     ("OSPA [m]", "ospa_m", 2),
     ("GOSPA [m]", "gospa_m", 2),
+    ("GOSPA c = 10 m, within LiDAR range [m]", "gospa_within_lidar_range_c10_m", 2),
     ("position RMSE [m]", "position_rmse_m", 2),
     ("median position error [m]", "median_position_error_m", 2),
     ("  within LiDAR range [m]", "median_position_error_within_lidar_range_m", 2),
@@ -82,6 +83,7 @@ _TABLE_ROWS = (
     ("SOG RMSE [m/s]", "sog_rmse_mps", 3),
     ("detection rate", "detection_rate", 3),
     ("max detection latency [s]", "detection_latency_max_s", 1),
+    ("  from first in range [s]", "detection_latency_from_first_in_range_max_s", 1),
     ("false targets / min", "false_targets_per_min", 2),
     ("false reports / min", "false_reports_per_min", 2),
     ("targets on land", "targets_on_land", 0),

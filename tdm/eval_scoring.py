@@ -20,6 +20,9 @@ from tdm.metrics import GOSPA_ALPHA, assign_distances, distance_matrix, gospa_di
 MIN_IN_VIEW_S = 5.0
 #: Truth SOG above which an object counts as moving for the COG error, m/s (task definition).
 MOVING_SOG_MPS = 0.5
+#: GOSPA's cut-off within LiDAR range, m: c = 50 m counts a 49 m error as a detection; near the own ship, where
+#: collision avoidance acts, 10 m (issue 22), beside the c of the whole scene.
+NEAR_GOSPA_C_M = 10.0
 #: Two-sided 95 % interval of chi-square with 2 degrees of freedom (CDF 1 - exp(-x/2)), dimensionless.
 NEES_95_INTERVAL = (-2.0 * math.log(0.975), -2.0 * math.log(0.025))
 #: Target descriptor expected for a truth kind (docs/formats.md, tdm/detected_targets.jsonl: "vessel" | "iceberg" | "unknown").
@@ -68,11 +71,14 @@ def subset(reports: dict[str, np.ndarray], mask: np.ndarray) -> dict[str, np.nda
 
 
 def _assign(truth: TruthAtEpochs, visible: np.ndarray, rep_pos: np.ndarray, report_epoch: np.ndarray,
-            c_m: float, p: float, dont_care: np.ndarray | None, on_land: np.ndarray | None = None) -> dict:
+            c_m: float, p: float, dont_care: np.ndarray | None, on_land: np.ndarray | None = None,
+            near: tuple[float, float] | None = None) -> dict:
     """Per epoch: the assignment, OSPA and GOSPA terms; the matched pairs (epoch, object, report, distance).
 
     A report ``on_land`` (N,) is at least the cut-off from every object: never matched nor ignored,
-    a false report (and a cardinality error in OSPA and GOSPA).
+    a false report (and a cardinality error in OSPA and GOSPA). ``near`` (range m, cut-off m): also GOSPA
+    with that cut-off over the objects and the (not ignored) reports within that range of the own ship
+    (``per_epoch["gospa_near"]``).
     """
     land = np.zeros(report_epoch.size, dtype=bool) if on_land is None else np.asarray(on_land, dtype=bool)
     E = visible.shape[0]
@@ -80,7 +86,9 @@ def _assign(truth: TruthAtEpochs, visible: np.ndarray, rep_pos: np.ndarray, repo
     order = kept[np.argsort(report_epoch[kept], kind="stable")]
     bounds = np.searchsorted(report_epoch[order], np.arange(E + 1))
     truth_pos = np.stack([truth.east_m, truth.north_m], axis=-1)  # (E, K, 2)
-    per_epoch = {name: np.zeros(E) for name in ("ospa", "gospa", "gospa_loc", "gospa_missed", "gospa_false")}
+    per_epoch = {name: np.zeros(E) for name in ("ospa", "gospa", "gospa_loc", "gospa_missed", "gospa_false",
+                                                 "gospa_near")}
+    own = np.stack([truth.own_east_m, truth.own_north_m], axis=-1)  # (E, 2)
     n_rep_e = np.diff(bounds)
     pairs_e, pairs_k, pairs_r, pairs_d = [], [], [], []
     is_ignored = np.zeros(report_epoch.size, dtype=bool)
@@ -100,6 +108,12 @@ def _assign(truth: TruthAtEpochs, visible: np.ndarray, rep_pos: np.ndarray, repo
         g = gospa_distances(d, c_m, p, GOSPA_ALPHA)
         per_epoch["gospa"][e], per_epoch["gospa_loc"][e] = g["total"], g["localisation"]
         per_epoch["gospa_missed"][e], per_epoch["gospa_false"][e] = g["missed"], g["false"]
+        if near is not None:
+            close_k = truth.range_m[e, ks] <= near[0]
+            close_r = np.hypot(*(rep_pos[rows] - own[e]).T) <= near[0]
+            per_epoch["gospa_near"][e] = gospa_distances(
+                _off_land(distance_matrix(truth_pos[e, ks[close_k]], rep_pos[rows[close_r]]), land[rows[close_r]],
+                          near[1]), near[1], p, GOSPA_ALPHA)["total"]
         r, cc = assign_distances(d, c_m, p)
         pairs_e.append(np.full(r.size, e))
         pairs_k.append(ks[r])
@@ -186,8 +200,11 @@ def _per_object(truth: TruthAtEpochs, visible: np.ndarray, reports: dict[str, np
                            "target_ids": sorted({int(x) for x in matched_tid[m_e, k]}),
                            "median_error_m": _median(err_mat[m_e, k])})
     latencies = np.array([v for v in latency.values() if v is not None])
+    from_first = np.array([o["latency_from_first_in_range_s"] for o in per_object
+                           if o["latency_from_first_in_range_s"] is not None])
     return {"detection_latency_s": latency,
             "detection_latency_max_s": float(np.max(latencies)) if latencies.size else math.nan,
+            "detection_latency_from_first_in_range_max_s": float(np.max(from_first)) if from_first.size else math.nan,
             "detection_latency_mean_s": _mean(latencies),
             "objects_in_range": len(latency), "missed_objects": sorted(missed),
             "id_switches": switches_total, "id_switches_max_per_object": switches_max, "per_object": per_object}
@@ -262,12 +279,13 @@ def score(truth: TruthAtEpochs, visible: np.ndarray, reports: dict[str, np.ndarr
     E = visible.shape[0]
     rep_pos = np.stack([reports["east_m"], reports["north_m"]], axis=-1)  # (N, 2)
     on_land = reports.get("on_land")
-    a = _assign(truth, visible, rep_pos, report_epoch, c_m, p, dont_care, on_land)
+    a = _assign(truth, visible, rep_pos, report_epoch, c_m, p, dont_care, on_land, (lidar_range_m, NEAR_GOSPA_C_M))
     per_epoch, pd = a["per_epoch"], a["pd"]
     n_visible = int(visible.sum())
     out = {name: float(np.mean(per_epoch[key])) if E else math.nan
            for name, key in (("ospa_m", "ospa"), ("gospa_m", "gospa"), ("gospa_localisation_m", "gospa_loc"),
-                             ("gospa_missed_mean", "gospa_missed"), ("gospa_false_mean", "gospa_false"))}
+                             ("gospa_missed_mean", "gospa_missed"), ("gospa_false_mean", "gospa_false"),
+                             ("gospa_within_lidar_range_c10_m", "gospa_near"))}
     out.update(_pair_errors(truth, reports, rep_pos, a, lidar_range_m))
     out["detection_rate"] = pd.size / n_visible if n_visible else math.nan
     out.update(_per_object(truth, visible, reports, a))

@@ -148,6 +148,8 @@ DEFINITIONS = {
     "ospa_m": "mean over epochs of OSPA (Schuhmacher 2008) on positions, cut-off c, order p",
     "gospa_m": "mean over epochs of GOSPA (Rahmathullah 2017, alpha 2); gospa_localisation_m, "
                "gospa_missed_mean, gospa_false_mean are the means of its terms",
+    "gospa_within_lidar_range_c10_m": "mean over epochs of GOSPA with c = 10 m (alpha 2, the same p) over the "
+                                      "in-range objects and the reports within the LiDAR's range of the own ship",
     "position_rmse_m": "RMS of ENU position error over matched pairs",
     "median_position_error_m": "median over matched pairs; _within/_beyond_lidar_range_m split by truth distance "
                                "from own ship vs lidar range_max_m",
@@ -156,7 +158,8 @@ DEFINITIONS = {
     "detection_rate": "matched (object, epoch) pairs / in-range (object, epoch) pairs",
     "detection_latency_s": "per object: first matched epoch - start of the first run of in-range epochs lasting "
                            ">= 5 s (at least 0; the first in-range epoch if no run is so long); null when never "
-                           "matched",
+                           "matched; detection_latency_from_first_in_range_max_s: the largest over objects of the "
+                           "first matched epoch - the first in-range epoch (per_object latency_from_first_in_range_s)",
     "false_targets_per_min": "target ids matched at fewer than half of their reported epochs, per minute of "
                              "manifest duration",
     "false_reports_per_min": "unmatched (target, epoch) reports per minute, ignored ones not counted",

@@ -51,6 +51,7 @@ def test_detection_latency_switches_and_false_targets(synthetic):
     assert m["detection_rate"] == pytest.approx(79 / 84, rel=1e-5)
     assert m["detection_latency_s"] == {"alpha": 0.0, "bravo": 0.0, "charlie": 5.0, "echo": 0.0}
     assert m["detection_latency_max_s"] == 5.0
+    assert m["detection_latency_from_first_in_range_max_s"] == 5.0  # charlie: in range from 0 s, found at 5 s
     assert m["missed_objects"] == []
     assert m["id_switches"] == 1 and m["id_switches_max_per_object"] == 1
     assert m["false_target_ids"] == [99]
@@ -93,6 +94,8 @@ def test_ospa_and_gospa_means(synthetic):
     gospa_early, gospa_late = math.sqrt(3 * 9 + C ** 2 / 2 * 2), math.sqrt(4 * 9 + C ** 2 / 2)
     assert m["ospa_m"] == pytest.approx((5 * ospa_early + 16 * ospa_late) / 21, rel=1e-5)
     assert m["gospa_m"] == pytest.approx((5 * gospa_early + 16 * gospa_late) / 21, rel=1e-5)
+    # within the LiDAR's 200 m of the own ship, c = 10 m: alpha alone (100-116 m off) and its report 3 m east
+    assert m["gospa_within_lidar_range_c10_m"] == pytest.approx(3.0, rel=1e-5)
     s = m["series"]
     assert len(s["t_s"]) == 21 and s["ospa_m"][0] == pytest.approx(ospa_early, rel=1e-5)
     assert s["n_in_range"] == [4] * 21 and s["n_reports"] == [4] * 5 + [5] * 16
