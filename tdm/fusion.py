@@ -86,6 +86,9 @@ class FusionConfig:
     # its centre lies behind. Fitted on busy_open_sea (seed 7, 300 s, the tuning scenario): the radar plots of its
     # icebergs lay a median 8.2 m in front of their centres, their range extent a median 11.3 m (docs/tdm.md)
     radar_hidden_depth_fraction: float = 0.7
+    # ... and the uncertainty of that depth, along the line of sight, as a fraction of the track's length (the
+    # same bergs' offsets scattered 2.8 m about their median, a quarter of their plots' range extent)
+    radar_hidden_depth_sigma_fraction: float = 0.25
 
 
 @dataclass
@@ -265,7 +268,8 @@ class Fuser:
 
     def _behind_the_face(self, states: dict, live: dict, own_m: np.ndarray) -> None:
         """Move the radar tracks of still targets without AIS along the line of sight by
-        ``radar_hidden_depth_fraction`` of their length (in ``states``, the tracks themselves untouched)."""
+        ``radar_hidden_depth_fraction`` of their length, with the variance of that depth added along it
+        (``radar_hidden_depth_sigma_fraction``); in ``states``, the tracks themselves untouched."""
         for target in self.targets:
             key = ("radar", target.members.get("radar", -1))
             if target.descriptor not in STILL_DESCRIPTORS or "ais" in target.members or key not in states:
@@ -274,8 +278,9 @@ class Fuser:
             sight = x[:2] - own_m
             distance = float(np.hypot(*sight))
             if distance > 0.0 and np.isfinite(live[key].length_m):
-                x = x.copy()
-                x[:2] += self.config.radar_hidden_depth_fraction * live[key].length_m * sight / distance
+                x, p, u = x.copy(), p.copy(), sight / distance
+                x[:2] += self.config.radar_hidden_depth_fraction * live[key].length_m * u
+                p[:2, :2] += (self.config.radar_hidden_depth_sigma_fraction * live[key].length_m) ** 2 * np.outer(u, u)
                 states[key] = (x, p)
 
     def _estimate(self, target: FusedTarget, states) -> tuple[np.ndarray, np.ndarray]:
