@@ -73,7 +73,8 @@ def test_a_still_targets_radar_track_is_put_its_hidden_depth_behind_the_face_alo
     depth = FusionConfig().radar_hidden_depth_fraction * 12.0
     assert depth > 0.0 and still.x[:2] == pytest.approx([0.0, 500.0 + depth])
     sigma = FusionConfig().radar_hidden_depth_sigma_fraction * 12.0  # the depth's uncertainty, along the sight line
-    assert still.p[:2, :2] == pytest.approx(np.diag([4.0, 4.0 + sigma**2]))
+    predicted = radar.predicted(1.0)[1][:2, :2]
+    assert still.p[:2, :2] == pytest.approx(predicted + np.diag([0.0, sigma**2]))
     assert radar.x[:2] == pytest.approx([0.0, 500.0])  # the track itself is untouched
     (no_own,) = fuser.step(2.0, {"radar": [radar]})
     assert no_own.x[:2] == pytest.approx([0.0, 500.0])
