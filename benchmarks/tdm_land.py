@@ -2,7 +2,7 @@
 
 Usage::
 
-    python benchmarks/tdm_land.py [--duration S] [--out benchmarks/results/tdm_land.md] [--json FILE]
+    python benchmarks/tdm_land.py [--duration S] [--reuse] [--out benchmarks/results/tdm_land.md] [--json FILE]
 
 For each scenario: ``raysim render`` into ``/tmp/tdm_land_<name>`` (every sensor), ``tdm run`` and
 ``tdm evaluate`` with the default configuration, then the done-when criteria of docs/tdm.md (the same
@@ -59,11 +59,14 @@ def on_land(recording: Path) -> tuple[int, int, list[float]]:
     return int(inside.sum()), len(rows), distances
 
 
-def run(name: str, duration_s: float) -> dict:
+def run(name: str, duration_s: float, reuse: bool = False) -> dict:
     out = Path(f"/tmp/tdm_land_{name}")
-    shutil.rmtree(out, ignore_errors=True)
     scenario = ROOT / "scenarios" / f"{name}.yaml"
-    assert raysim_main(["render", str(scenario), "-o", str(out), "--duration", f"{duration_s:g}", "--no-progress"]) == 0
+    manifest = out / "manifest.json"
+    if not (reuse and manifest.is_file() and abs(json.loads(manifest.read_text())["duration_s"] - duration_s) < 1e-9):
+        shutil.rmtree(out, ignore_errors=True)
+        assert raysim_main(["render", str(scenario), "-o", str(out), "--duration", f"{duration_s:g}",
+                            "--no-progress"]) == 0
     assert tdm_main(["run", str(out)]) == 0
     assert tdm_main(["evaluate", str(out), "--no-plots"]) == 0
     metrics = json.loads((out / "tdm" / "metrics.json").read_text())
@@ -80,8 +83,10 @@ def main(argv=None) -> int:
     parser.add_argument("--duration", type=float, default=300.0)
     parser.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results" / "tdm_land.md")
     parser.add_argument("--json", type=Path)
+    parser.add_argument("--reuse", action="store_true",
+                        help="run the TDM on the renders already in /tmp/tdm_land_<name> (after a TDM change)")
     args = parser.parse_args(argv)
-    results = {name: run(name, args.duration) for name in SCENARIOS}
+    results = {name: run(name, args.duration, args.reuse) for name in SCENARIOS}
     fmt = lambda v: "-" if v is None else (f"{v:.2f}" if isinstance(v, float) else str(v))  # noqa: E731
     lines = ["| criterion | " + " | ".join(f"{n}, {args.duration:g} s" for n in SCENARIOS) + " | asked |",
              "|---|" + "---:|" * (len(SCENARIOS) + 1)]
