@@ -83,8 +83,8 @@ def _frontend(job: tuple[str, object]) -> FrontendResult:
         dets = lidar_detections(sweep, _WORKER["track"], mount, cfg, land)
     else:
         dets = radar_detections(sweep, _WORKER["track"], mount, cfg)
-        dets = drop_on_land(dets, land, cfg.land_beam_fraction, cfg.beam_az_deg)
-    dets = drop_on_land(dets, land)
+    beam = (cfg.land_beam_fraction, cfg.beam_az_deg) if sensor == "radar" else (0.0, 0.0)
+    dets = drop_on_land(dets, land, *beam)  # radar: also within half a beam of the land
     return sensor, float(np.min(times)), float(np.max(times)), dets, None, path
 
 

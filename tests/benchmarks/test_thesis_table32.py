@@ -51,22 +51,23 @@ def test_every_source_tracks_the_vessel(table):
 STD_NOT_BEATEN = pytest.mark.xfail(strict=True, reason="the LiDAR's track scatters less than the fused one")
 
 
+def _assert_fused_below_every_sensor(table: dict, state: str, measure: str) -> None:
+    """The fused track's ``measure`` ("std" or "rmse") of ``state`` is under each single sensor's."""
+    fused = table["sources"]["fused"][state][measure]
+    for sensor in ("ais", "radar", "lidar"):
+        single = table["sources"][sensor][state][measure]
+        assert math.isfinite(single) and math.isfinite(fused), (sensor, state, single, fused)
+        assert fused < single, f"{state}: fused {measure} {fused:.4g} >= {sensor} {measure} {single:.4g}"
+
+
 @pytest.mark.bench
 @pytest.mark.parametrize("state", [pytest.param("north_m", marks=STD_NOT_BEATEN), "east_m", "cog_deg",
                                    pytest.param("sog_mps", marks=STD_NOT_BEATEN)])
 def test_fused_std_below_every_sensor(table, state):
-    fused = table["sources"]["fused"][state]["std"]
-    for sensor in ("ais", "radar", "lidar"):
-        single = table["sources"][sensor][state]["std"]
-        assert math.isfinite(single) and math.isfinite(fused), (sensor, state, single, fused)
-        assert fused < single, f"{state}: fused std {fused:.4g} >= {sensor} std {single:.4g}"
+    _assert_fused_below_every_sensor(table, state, "std")
 
 
 @pytest.mark.bench
 @pytest.mark.parametrize("state", ["north_m", "east_m", "cog_deg", "sog_mps"])
 def test_fused_rmse_below_every_sensor_after_the_first_50_s(table, state):
-    fused = table["sources"]["fused"][state]["rmse"]
-    for sensor in ("ais", "radar", "lidar"):
-        single = table["sources"][sensor][state]["rmse"]
-        assert math.isfinite(single) and math.isfinite(fused), (sensor, state, single, fused)
-        assert fused < single, f"{state}: fused RMSE {fused:.4g} >= {sensor} RMSE {single:.4g}"
+    _assert_fused_below_every_sensor(table, state, "rmse")
