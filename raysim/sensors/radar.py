@@ -49,7 +49,8 @@ from raysim.sensors import radar_physics as phys
 from raysim.sensors import radar_receiver
 from raysim.sensors.carrier import CarrierScene
 from raysim.sensors.context import SensorContext
-from raysim.sensors.radar_beam import antenna_pattern, block_kernel, convolve_cells, convolve_rows_sparse, range_kernel
+from raysim.sensors.radar_beam import (antenna_pattern, block_kernel, convolve_cells_compact, convolve_rows_sparse,
+                                      range_kernel)
 from raysim.sensors.radar_clutter import SeaClutter
 from raysim.sensors.radar_interference import Interference, reject
 from raysim.sensors.radar_rain import RainEchoes, RainField
@@ -255,10 +256,12 @@ class RadarRenderer:
         with the range impulse response."""
         return convolve_rows_sparse(rows, self.range_kernel, cells)
 
-    def range_filter_cells(self, values: np.ndarray, cells: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
+    def range_filter_cells(self, values: np.ndarray, cells: np.ndarray,
+                           shape: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`range_filter` of the (M, N) echoes that are ``values`` (Q,) complex at the flat indices ``cells``
-        (Q,) and zero elsewhere; returns (M, N) complex."""
-        return convolve_cells(values, cells, shape, self.range_kernel)
+        (Q,) and zero elsewhere, on the cells the filter reaches: (P,) increasing flat indices and (P,) complex
+        values (:func:`~raysim.sensors.radar_beam.convolve_cells_compact`)."""
+        return convolve_cells_compact(values, cells, shape, self.range_kernel)
 
     def range_skirt(self, power_rows: np.ndarray) -> np.ndarray | None:
         """(M, B) incoherent range skirt (phase noise) of (M, N) echo powers in blocks of SKIRT_BLOCK samples.

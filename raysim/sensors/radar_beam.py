@@ -123,20 +123,67 @@ def convolve_cells(values: np.ndarray, flat: np.ndarray, shape: tuple[int, int],
     (M, N) array of the type of ``values``
     """
     m, n = shape
+    cells, out_values = convolve_cells_compact(values, flat, shape, kernel)
+    out = np.zeros(m * n, out_values.dtype)
+    out[cells] = out_values
+    return out.reshape(m, n)
+
+
+def convolve_cells_compact(values: np.ndarray, flat: np.ndarray, shape: tuple[int, int],
+                           kernel: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`convolve_cells` on the cells it reaches only: no dense (M, N) array is formed.
+
+    A coast paints on every spoke, so M is all spokes while the cells reached are a few per cent of (M, N): the
+    dense output's zeros would cost more than the sums. Each reached cell's sum is taken over its contributions in
+    the same order and in float64 as a dense ``np.bincount`` would, so the values equal :func:`convolve_cells`'s
+    bit for bit.
+
+    Parameters
+    ----------
+    values : (Q,) float or complex
+        The non-zero cells' values.
+    flat : (Q,) int
+        Their flat indices in the (M, N) array (distinct).
+    shape : (int, int)
+        M, N.
+    kernel : (L,) float
+        Centred kernel, L odd.
+
+    Returns
+    -------
+    cells : (P,) int64
+        Increasing flat indices of the cells some tap reaches (a reached cell may sum to zero).
+    out_values : (P,) of the type of ``values``
+        The convolution at ``cells``.
+    """
+    n = shape[1]
     half = kernel.size // 2
     cols = flat % n
+    row_start = flat - cols
+    # each cell reaches the run [lo, hi] of its row; the runs start and end in increasing order (flat increases),
+    # so their union is, run by run, the cells past the previous run's end: first .. hi
+    lo = np.maximum(flat - half, row_start)
+    hi = np.minimum(flat + half, row_start + n - 1)
+    first = np.maximum(lo, np.r_[-1, hi[:-1]] + 1)
+    count = np.maximum(hi - first + 1, 0)
+    before = np.cumsum(count) - count  # reached cells before ``first``: every cell lo .. hi is reached, so the
+    # slot of cell c of run q is before_q + (c - first_q)
+    cells = np.repeat(first - before, count) + np.arange(int(count.sum()))
     taps = np.arange(-half, half + 1)
     target = cols[:, None] + taps[None, :]  # (Q, L) column each tap lands on
     inside = (target >= 0) & (target < n)
-    where = (flat[:, None] + taps[None, :])[inside]
-    spread = (values[:, None] * kernel[None, :])[inside]
-    if np.iscomplexobj(values):
-        out = np.empty(m * n, values.dtype)
-        out.real = np.bincount(where, weights=spread.real, minlength=m * n)
-        out.imag = np.bincount(where, weights=spread.imag, minlength=m * n)
+    slot = (flat - first + before)[:, None] + taps[None, :]
+    slot = slot[inside]
+    parts = (values.real, values.imag) if np.iscomplexobj(values) else (values,)
+    # float64 products and sums, taken in the order a dense ``np.bincount`` over (Q, L) takes them
+    sums = [np.bincount(slot, weights=(part[:, None] * kernel[None, :])[inside], minlength=cells.size)
+            for part in parts]
+    out_values = np.empty(cells.size, values.dtype)
+    if len(sums) == 2:
+        out_values.real, out_values.imag = sums
     else:
-        out = np.bincount(where, weights=spread, minlength=m * n).astype(values.dtype)
-    return out.reshape(m, n)
+        out_values[:] = sums[0]
+    return cells, out_values
 
 
 def block_kernel(kernel: np.ndarray | None, block: int) -> np.ndarray | None:

@@ -373,12 +373,20 @@ class TargetEchoes:
         # meet in ``power`` after both, in either order the same bytes (two terms: IEEE addition commutes)
         with ThreadPoolExecutor(max_workers=1, thread_name_prefix="radar-skirt") as pool:
             skirt = pool.submit(self._skirt, rows, cells, values)
-            field = r.range_filter_cells(values, cells, (rows.size, N))
+            # the range filter on the cells it reaches (a coast on every spoke: a dense field would be mostly zeros)
+            reached, field = r.range_filter_cells(values, cells, (rows.size, N))
+            row_of, col_of = np.divmod(reached, N)
             # range samples whose strongest echo, even at the beam's peak, stays under INVISIBLE_SNR: left out
-            cols = np.flatnonzero((field.real**2 + field.imag**2).max(axis=0) > INVISIBLE_SNR)
+            peak = np.zeros(N, np.float32)
+            np.maximum.at(peak, col_of, field.real**2 + field.imag**2)
+            cols = np.flatnonzero(peak > INVISIBLE_SNR)
             if cols.size:
+                slot_of_col = np.full(N, -1, np.int64)
+                slot_of_col[cols] = np.arange(cols.size)
+                slot = slot_of_col[col_of]
+                kept = slot >= 0
                 full = np.zeros((S, cols.size), np.complex64)
-                full[rows] = field[:, cols]
+                full[rows[row_of[kept]], slot[kept]] = field[kept]
                 spectrum = scipy.fft.fft(full, axis=0, workers=FFT_WORKERS, overwrite_x=True)
                 spectrum *= self._az_kernel_f
                 sub = scipy.fft.ifft(spectrum, axis=0, workers=FFT_WORKERS, overwrite_x=True)
