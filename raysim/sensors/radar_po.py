@@ -40,6 +40,29 @@ def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.einsum("ij,ij->i", a, b)
 
 
+def _sinc_of_phase(k_rad_m: float, g_dot_axis: np.ndarray, width_m: np.ndarray) -> np.ndarray:
+    """``np.sinc(k g_dot_axis width / (2 pi))`` (M,), by numpy's own steps in place: the same bytes, fewer copies.
+
+    Parameters
+    ----------
+    k_rad_m : float
+        Wavenumber, rad/m.
+    g_dot_axis : (M,) float64
+        Phase gradient along the tube's axis (consumed: overwritten).
+    width_m : (M,) float64
+        Tube width along that axis, m.
+    """
+    x = g_dot_axis
+    x *= k_rad_m  # k g: evaluated left to right as in ``k * g * w / (2 pi)``
+    x *= width_m
+    x /= 2.0 * math.pi
+    x *= math.pi  # numpy's sinc: y = pi x, eps where y == 0, sin(y) / y
+    x[x == 0] = np.finfo(x.dtype).eps
+    out = np.sin(x)
+    out /= x
+    return out
+
+
 def reflect(v: np.ndarray, n: np.ndarray) -> np.ndarray:
     """Mirror (M, 3) vectors ``v`` in planes of unit normals ``n`` (M, 3): ``v - 2 (v.n) n``."""
     return v - 2.0 * dot(v, n)[:, None] * n
@@ -74,8 +97,8 @@ def patch_amplitude(k_rad_m: float, normal: np.ndarray, d_tube: np.ndarray, axis
     n_dot_d = np.where(np.abs(n_dot_d) < 1e-9, -1e-9, n_dot_d)
     diff = d_in - d_out
     g = diff - normal * (dot(diff, d_tube) / n_dot_d)[:, None]
-    shape = (np.sinc(k_rad_m * dot(g, axis_u) * width_u_m / (2.0 * math.pi))
-             * np.sinc(k_rad_m * dot(g, axis_v) * width_v_m / (2.0 * math.pi)))
+    shape = _sinc_of_phase(k_rad_m, dot(g, axis_u), width_u_m)
+    shape *= _sinc_of_phase(k_rad_m, dot(g, axis_v), width_v_m)
     area_m2 = width_u_m * width_v_m / np.abs(n_dot_d)
     lit = (dot(normal, d_in) < 0.0) & (dot(normal, d_out) > 0.0)
     obliquity = np.where(lit, -dot(normal, diff) / 2.0, 0.0)

@@ -222,13 +222,17 @@ class TargetEchoes:
             gamma = sea_gamma(sin_psi, r.env.sea_state, r.p.f_ghz, r.p.polarisation)
             el_i = el_d + (-np.arcsin(np.clip(sin_psi, -1, 1)) - np.arcsin(np.clip(d[:, 2], -1, 1)))
             g_i = self._v_gain(el_i) * gamma
-            path += [(d_img, -d, l_img + r_h, g_i * g_d), (d, -d_img, r_h + l_img, g_d * g_i),
+            # out by the sea and back direct, and its reverse: the same patch amplitude (d_in - d_out, lit legs and
+            # length alike), formed once and added twice (term by term, as two paths are)
+            path += [(d_img, -d, l_img + r_h, g_i * g_d), (None, None, None, g_d * g_i),
                      (d_img, -d_img, 2.0 * l_img, g_i * g_i)]
             lit_img = -dot(n, d_img) > 0.0
             diffuse_legs = g_d + np.where(lit_img, g_i, 0.0) * np.exp(-1j * self.k * (l_img - r_h))
         spec = np.zeros(h.size, complex)
         for d_in, d_out, length, gain in path:
-            spec += gain * patch_amplitude(self.k, n, d, u, v, w_u, w_v, d_in, d_out, length)
+            if d_in is not None:
+                patch = patch_amplitude(self.k, n, d, u, v, w_u, w_v, d_in, d_out, length)
+            spec += gain * patch
         spec *= np.sqrt(rho * q)
         sigma_rough = (r.p.diffuse_gain * rho * (1.0 - q) * w_u * w_v * (4.0 * (lobe_n + 2.0) / 3.0)
                        * np.power(cos_i, lobe_n))
