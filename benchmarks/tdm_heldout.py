@@ -46,6 +46,7 @@ if str(ROOT) not in sys.path:
 from benchmarks.common import machine_line  # noqa: E402
 from raysim.render import render  # noqa: E402
 from raysim.scenario import load_scenario, with_overrides  # noqa: E402
+from tdm.eval_best_sensor import FIGURES  # noqa: E402
 from tdm.evaluate import evaluate, write_metrics  # noqa: E402
 from tdm.pipeline import TdmConfig, run_tdm  # noqa: E402
 
@@ -106,7 +107,19 @@ def run_criteria(metrics: dict, closest: dict[str, float]) -> dict:
             default=None),
         "cog_rmse_deg": metrics.get("cog_rmse_deg"),
         "nees_fraction_in_95_per_sensor": {s: m.get("nees_fraction_in_95") for s, m in metrics["per_sensor"].items()},
+        "fusion_against_sensors": _versus(metrics.get("fusion_against_sensors")),
     }
+
+
+def _versus(versus: dict | None) -> dict | None:
+    """The summary of the fusion against its best sensor, and per object it loses on: the figures and reasons."""
+    if versus is None:
+        return None
+    losing = [{"name": o["name"], "sensors": o["sensors"],
+               "lost": {k: [v["fused"], v["best_sensor"], v["sensor"]] for k, v in o["figures"].items()
+                        if not o["beats"][k]},
+               "why_not": o["why_not"]} for o in versus["objects"] if not o["beats_best_on_all"]]
+    return {**versus["summary"], "losing": losing}
 
 
 def passes(value, limit, sense: str) -> bool | None:
@@ -184,7 +197,38 @@ def report(runs: list[dict], scenarios: list[str], seeds: list[int], duration_s:
              f"seeds {seeds[0]}-{seeds[-1]} (every sensor). A cell: the median over the seeds (min-max), then "
              "**how many runs meet the criterion / how many runs it applies to** (an error within LiDAR range "
              "applies only to runs with an object within it).", ""]
-    return "\n".join(["# The TDM on held-out scenarios", "", *intro, *lines, "", "## Every run", "", *per_run, ""])
+    return "\n".join(["# The TDM on held-out scenarios", "", *intro, *lines, "", *versus_report(runs, scenarios),
+                      "## Every run", "", *per_run, ""])
+
+
+def versus_report(runs: list[dict], scenarios: list[str]) -> list[str]:
+    """Markdown: per scenario, the objects on which the fusion beats its best sensor, per figure; the losses."""
+    names = [name for name, *_ in FIGURES]
+    lines = ["## The fusion against its best sensor", "",
+             "Per object seen by two or more sensors' own tracks (on at least 10 epochs each shared with the fused "
+             "targets), the fused error against the best sensor's on the epochs both report it "
+             "(tdm/eval_best_sensor.py). A cell: objects where the fusion is no worse / objects compared, summed "
+             "over the seeds.", "",
+             "| scenario | beats on all six | " + " | ".join(names) + " |", "|---|---:|" + "---:|" * len(names)]
+    losses = []
+    for scenario in scenarios:
+        mine = [r for r in runs if r["scenario"] == scenario and r.get("fusion_against_sensors")]
+        if not mine:
+            continue
+        v = [r["fusion_against_sensors"] for r in mine]
+        cells = [f"{sum(x['per_figure'][n]['beats'] for x in v)}/{sum(x['per_figure'][n]['compared'] for x in v)}"
+                 for n in names]
+        lines.append(f"| {scenario}, {len(mine)} seeds | {sum(x['objects_fusion_beats_best_on_all'] for x in v)}/"
+                     f"{sum(x['objects_compared'] for x in v)} | " + " | ".join(cells) + " |")
+        for r in mine:
+            for o in r["fusion_against_sensors"]["losing"]:
+                lost = ", ".join(f"{k} {f:.3g} vs {b} {b_v:.3g}" for k, (f, b, b_v) in o["lost"].items())
+                losses.append(f"| {scenario} | {r['seed']} | {o['name']} | {', '.join(o['sensors'])} | {lost} | "
+                              f"{'; '.join(o['why_not'])} |")
+    if losses:
+        lines += ["", "Where the fusion loses (fused vs best sensor on their common epochs; the computed reason):", "",
+                  "| scenario | seed | object | sensors | lost | why |", "|---|---:|---|---|---|---|", *losses]
+    return lines + [""]
 
 
 def _seeds(text: str) -> list[int]:

@@ -117,6 +117,11 @@ def format_table(metrics: dict) -> str:
              "metric".ljust(label_w) + "".join(name.rjust(9) for name, _ in columns)]
     for label, key, digits in _TABLE_ROWS:
         lines.append(label.ljust(label_w) + "".join(_fmt(m.get(key), digits).rjust(9) for _, m in columns))
+    versus = (metrics.get("fusion_against_sensors") or {}).get("summary")
+    if versus and versus.get("objects_compared"):
+        lines.append(f"fusion beats its best sensor on all six figures (position, COG, SOG; RMSE and median): "
+                     f"{versus['objects_fusion_beats_best_on_all']} of {versus['objects_compared']} objects "
+                     f"seen by two or more sensors")
     objects = metrics.get("per_object") or []
     if objects:
         name_w = max(12, max(len(o["name"]) for o in objects) + 2)

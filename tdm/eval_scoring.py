@@ -11,6 +11,7 @@ import math
 
 import numpy as np
 
+from tdm.eval_best_sensor import pair_errors
 from tdm.eval_truth import TruthAtEpochs
 from tdm.metrics import GOSPA_ALPHA, assign_distances, distance_matrix, gospa_distances, ospa_distances
 
@@ -150,7 +151,11 @@ def _pair_errors(truth: TruthAtEpochs, reports: dict[str, np.ndarray], rep_pos: 
     classed = np.array([k in DESCRIPTOR_OF_KIND for k in kinds], dtype=bool)
     expected = np.array([DESCRIPTOR_OF_KIND.get(k, "") for k in kinds], dtype=object)
     correct = (reports["descriptor"][pr] == expected)[classed] if pr.size else np.zeros(0, dtype=bool)
+    cog_err = np.full(pr.size, np.nan)
+    cog_err[moving] = cog_diff
+    sog_err = np.where(sog_ok, sog_r - sog_t, np.nan)
     return {
+        "_pairs": pair_errors(pe, pk, err, cog_err, sog_err),
         "position_rmse_m": _rms(pd),
         "median_position_error_m": _median(pd),
         "median_position_error_within_lidar_range_m": _median(pd[within]),

@@ -101,6 +101,7 @@ refuses"); a sweep file cut short is a warning, counted under ``"warnings"`` (on
 
 Modules: :mod:`tdm.eval_params` (manifest and scenario values), :mod:`tdm.eval_truth` (truth,
 epochs), :mod:`tdm.eval_visibility` (in range), :mod:`tdm.eval_scoring` (the metrics),
+:mod:`tdm.eval_best_sensor` (the fusion against its best sensor, per object),
 :mod:`tdm.eval_report` (metrics.json, table); this module puts them together.
 """
 
@@ -113,6 +114,7 @@ import numpy as np
 from tdm.errors import RecordingError
 from tdm.eval_lines import read_report_columns, read_reports, reports_in_frame
 from tdm.eval_params import DEFAULT_LIDAR_RANGE_M, DEFAULT_UPDATE_RATE_HZ, SENSORS, read_params
+from tdm.eval_best_sensor import fusion_against_sensors
 from tdm.eval_report import FULL_PRECISION_DIGITS, FULL_PRECISION_KEYS, SIGNIFICANT_DIGITS, _clean, format_table, \
     write_metrics
 from tdm.eval_scoring import DESCRIPTOR_OF_KIND, MIN_IN_VIEW_S, MOVING_SOG_MPS, NEES_95_INTERVAL, score, subset
@@ -172,6 +174,11 @@ DEFINITIONS = {
     "nees": "mean of e^T P^-1 e over matched pairs (ideal 2); nees_fraction_in_95: inside [0.0506, 7.378]",
     "classification_accuracy": "matched ship/iceberg pairs whose descriptor is vessel/iceberg",
     "per_sensor": "same metrics per sensor of sensor_tracks.jsonl against that sensor's in-range objects",
+    "fusion_against_sensors": "per object reported by two or more sensors' tracks on >= 10 epochs each shared "
+                              "with the fused targets: position error, |COG error| (moving objects) and |SOG "
+                              "error|, each RMSE and median, of the fused targets against the best sensor's on "
+                              "the epochs both report the object; beats: fused <= best sensor; why_not: the "
+                              "computed reason where it loses on an RMSE (tdm/eval_best_sensor.py)",
 }
 
 
@@ -265,6 +272,9 @@ def evaluate(recording: Path, c_m: float = DEFAULT_CUTOFF_M, p: float = DEFAULT_
             per_sensor[sensor] = score(truth, visible_by_sensor.get(sensor, visible), subset(tracks, mask),
                                        track_epoch[mask], c_m, p, duration_s, lidar_range_m, with_series=False,
                                        dont_care=hidden_by_sensor.get(sensor))
+    metrics["fusion_against_sensors"] = fusion_against_sensors(
+        truth.names, truth.ids, truth.range_m.shape[0], metrics.pop("_pairs"),
+        {sensor: m.pop("_pairs") for sensor, m in per_sensor.items()})
     metrics["per_sensor"] = per_sensor
     frame = inputs["frame"]
     metrics["parameters"] = {**inputs["used"], "c_m": c_m, "p": p, "gospa_alpha": GOSPA_ALPHA,

@@ -112,6 +112,9 @@ def test_per_sensor_metrics_use_each_sensors_range(synthetic):
     assert radar["position_rmse_m"] == pytest.approx(1.0, abs=1e-4)
     assert radar["detection_rate"] == pytest.approx(21 / 63, rel=1e-5)  # radar range holds alpha, bravo, charlie
     assert radar["nees"] == pytest.approx(1.0, rel=1e-4)
+    assert "_pairs" not in ais and "_pairs" not in m
+    # each object is tracked by one sensor only (AIS: alpha and echo, radar: bravo): none to set the fusion against
+    assert m["fusion_against_sensors"]["summary"]["objects_compared"] == 0
 
 
 def test_metrics_json_is_atomic_sorted_and_null_for_nan(synthetic, tmp_path):
