@@ -128,7 +128,7 @@ class _Tracking:
         descriptors = {(s, i): t.descriptor for t in self.fuser.targets for s, i in t.members.items()}
         for sensor, tracks in by_sensor.items():
             for tr in tracks:
-                x, p = tr.predicted(t_out)
+                x, p = tr.reported(t_out)
                 if self.on_land(x):
                     continue
                 write_track(target_record(t_out, tr.track_id, descriptors.get((sensor, tr.track_id), "unknown"),

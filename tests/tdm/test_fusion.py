@@ -174,3 +174,18 @@ def test_a_ship_passing_close_to_a_still_berg_does_not_swallow_it():
         assert len(out) == 2, t
         (berg_target,) = [e.target for e in out if e.target.mmsi is None]
         assert berg_target.target_id == berg_id and berg_target.descriptor == "iceberg"
+
+
+@pytest.mark.parametrize("weigh", [False, True])
+def test_the_centres_uncertainty_weighs_the_output_only_when_asked(weigh):
+    """A LiDAR track (var 1 m^2) and a radar track 4 m east (var 4 m^2, 12 m long, extent 0.5 of it: +36 m^2):
+    by default the fusion weighs the filters' covariances (1 : 4); with ``weigh_extent`` the radar's 40 m^2."""
+    fuser = Fuser(FusionConfig(weigh_extent=weigh))
+    lidar = make_track(1, "lidar", 0.0, 100.0, var=1.0)
+    radar = make_track(2, "radar", 4.0, 100.0, var=4.0)
+    radar.length_m, radar.extent_sigma_fraction = 12.0, 0.5
+    (out,) = fuser.step(0.0, {"lidar": [lidar], "radar": [radar]})
+    radar_var = 4.0 + (36.0 if weigh else 0.0)
+    assert out.x[0] == pytest.approx(4.0 * (1.0 / radar_var) / (1.0 + 1.0 / radar_var))
+    assert out.p[0, 0] == pytest.approx(1.0 / (1.0 + 1.0 / radar_var))
+    np.testing.assert_array_equal(radar.predicted(0.0)[1], make_track(2, "radar", 4.0, 100.0, var=4.0).p)

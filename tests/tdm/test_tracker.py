@@ -1,5 +1,7 @@
 """Per-sensor trackers on synthetic detections with known truth."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -149,3 +151,24 @@ def test_an_ais_track_starts_at_its_first_report(range_m):
     assert np.degrees(track.x[2]) % 360.0 == pytest.approx(120.0)
     assert track.x[3] == pytest.approx(6.0)
     assert track.p[0, 0] == pytest.approx(AisTrackerConfig().position_var_m2)  # the report's own variance
+
+
+def test_a_track_reports_the_uncertainty_of_the_centre_behind_the_side_it_sees():
+    """extent_sigma_fraction f: the reported position covariance grows by (f L)^2 per axis, the filter does not."""
+    dets = scan(0.0, [[100.0, 200.0]], sigma=1.0)
+    dets.length_m = np.array([20.0])
+    plain = PositionTracker("radar", CFG)
+    wide = PositionTracker("radar", replace(CFG, extent_sigma_fraction=0.25))
+    for k in range(4):
+        for tracker in (plain, wide):
+            dets.time_s = np.full(1, float(k))
+            tracker.process(dets, np.zeros(2))
+    (a,), (b,) = plain.tracks, wide.tracks
+    np.testing.assert_array_equal(a.p, b.p)  # the filter is the same
+    x_a, p_a = a.reported(5.0)
+    x_b, p_b = b.reported(5.0)
+    np.testing.assert_array_equal(x_a, x_b)
+    np.testing.assert_array_equal(p_a, a.predicted(5.0)[1])  # no extent term: reported = predicted
+    assert a.length_m == pytest.approx(20.0)
+    np.testing.assert_allclose(p_b[:2, :2] - p_a[:2, :2], (0.25 * 20.0) ** 2 * np.eye(2))
+    np.testing.assert_array_equal(p_b[2:, 2:], p_a[2:, 2:])
