@@ -50,6 +50,9 @@ POSITION_DOF = 2
 FOOTPRINT_SIGMAS = 3.0
 #: Two targets without AIS are one object only if their velocities differ by less than this, m/s.
 MERGE_SPEED_MPS = 2.0
+#: ... and a target without AIS inside an AIS ship's footprint is another object when its velocity differs from
+#: the ship's by more than MERGE_SPEED_MPS plus this many standard deviations of its own velocity.
+MERGE_SIGMAS = 3.0
 #: A target is a vessel once it has moved (faster than ``vessel_speed_mps`` by VESSEL_SIGMAS standard
 #: deviations of its speed) for this long, s.
 VESSEL_MOVING_S = 5.0
@@ -120,6 +123,30 @@ class FusedEstimate:
     x: np.ndarray  # (6,)
     p: np.ndarray  # (6, 6)
     sources: list[str]
+
+
+def _moves_apart(older: tuple[np.ndarray, np.ndarray], younger: tuple[np.ndarray, np.ndarray],
+                 older_has_ais: bool) -> bool:
+    """Whether the target without AIS moves otherwise than the AIS ship it lies inside: their velocities
+    differ by more than MERGE_SPEED_MPS plus MERGE_SIGMAS standard deviations of its velocity.
+
+    A fragment of the AIS ship (a new radar track of its bow or stern) has an uncertain velocity and folds
+    in; a ship crossing close by, tracked long enough to know its own velocity, does not (crossing_silent_ship,
+    seeds 31-32: the silent crosser's target was folded into the overtaking ferry's as they passed, and its id
+    went to the ferry).
+
+    Parameters
+    ----------
+    older, younger : tuple of (6,) and (6, 6) float
+        The two targets' fused states and covariances (:mod:`tdm.ekf`).
+    older_has_ais : bool
+        Which of the two has the AIS track.
+    """
+    (x_ais, _), (x_other, p_other) = (older, younger) if older_has_ais else (younger, older)
+    difference = float(np.hypot(*(ekf.velocity_en(x_ais) - ekf.velocity_en(x_other))))
+    speed = abs(float(x_other[ekf.U]))
+    sigma = float(np.sqrt(max(p_other[ekf.U, ekf.U], 0.0) + speed**2 * max(p_other[ekf.PSI, ekf.PSI], 0.0)))
+    return difference > MERGE_SPEED_MPS + MERGE_SIGMAS * sigma
 
 
 def fuse(xs: np.ndarray, ps: np.ndarray, rule: str = "simple") -> tuple[np.ndarray, np.ndarray]:
@@ -338,8 +365,9 @@ class Fuser:
 
         Same object: one lies inside the other's footprint (as for absorbing tracks), they are not a
         still target and a moving one (:meth:`_passing`), and either
-        exactly one of them has an AIS track (a radar or LiDAR target of an AIS ship), or neither
-        has and they move alike (within 2 m/s). The older target keeps its id; the younger's
+        exactly one of them has an AIS track (a radar or LiDAR target of an AIS ship) and the other's
+        velocity is not known to differ from the AIS ship's (:func:`_moves_apart`: two ships crossing),
+        or neither has and they move alike (within 2 m/s). The older target keeps its id; the younger's
         tracks fill the sensors the older lacks and are absorbed otherwise.
         """
         targets = sorted(self.targets, key=lambda t: (t.created_s, t.target_id))
@@ -361,6 +389,8 @@ class Fuser:
                 if n_ais == 2:
                     continue
                 if n_ais == 0 and np.hypot(*(ekf.velocity_en(xo) - ekf.velocity_en(xy))) > MERGE_SPEED_MPS:
+                    continue
+                if n_ais == 1 and _moves_apart(est[older.target_id], (xy, py), "ais" in older.members):
                     continue
                 for sensor, track_id in younger.members.items():
                     if sensor in older.members:

@@ -189,3 +189,31 @@ def test_the_centres_uncertainty_weighs_the_output_only_when_asked(weigh):
     assert out.x[0] == pytest.approx(4.0 * (1.0 / radar_var) / (1.0 + 1.0 / radar_var))
     assert out.p[0, 0] == pytest.approx(1.0 / (1.0 + 1.0 / radar_var))
     np.testing.assert_array_equal(radar.predicted(0.0)[1], make_track(2, "radar", 4.0, 100.0, var=4.0).p)
+
+
+def _moving_track(track_id, sensor, east, north, course_deg, speed_mps, speed_sigma_mps, mmsi=None):
+    track = make_track(track_id, sensor, east, north, var=4.0, mmsi=mmsi)
+    track.x[ekf.PSI], track.x[ekf.U] = np.radians(course_deg), speed_mps
+    track.p[ekf.U, ekf.U], track.p[ekf.PSI, ekf.PSI] = speed_sigma_mps**2, np.radians(2.0) ** 2
+    return track
+
+
+@pytest.mark.parametrize("speed_sigma_mps, folds", [(0.3, False), (3.0, True)])
+def test_a_ship_crossing_inside_an_ais_ships_footprint_keeps_its_target(speed_sigma_mps, folds):
+    """crossing_silent_ship: a silent ship (west at 3.5 m/s, tracked long: speed known to 0.3 m/s) passes 20 m
+    from a 60 m AIS ferry going north at 6 m/s: two objects, each keeps its id. A new radar track of the ferry's
+    bow with an unknown speed (3 m/s) at the same place folds into the ferry."""
+    fuser = Fuser(FusionConfig())
+    fuser.lengths_by_mmsi = {257000112: 60.0}
+    crosser = _moving_track(1, "radar", 20.0, 0.0, 270.0, 3.5, speed_sigma_mps)
+    ferry = _moving_track(5, "ais", 0.0, 0.0, 0.0, 6.0, 0.2, mmsi=257000112)
+    out = fuser.step(1.0, {"radar": [crosser]})
+    crosser_id = out[0].target.target_id
+    for t_s in (2.0, 3.0):  # the ferry's length is known from its second epoch on (its target's MMSI)
+        out = fuser.step(t_s, {"radar": [crosser], "ais": [ferry]})
+    if folds:
+        assert len(out) == 1 and out[0].target.mmsi == 257000112
+    else:
+        assert len(out) == 2
+        (silent,) = [e for e in out if e.target.mmsi is None]
+        assert silent.target.target_id == crosser_id and silent.sources == ["radar"]
