@@ -275,7 +275,28 @@ class TargetEchoes:
         for s_out, l_out, gain in outs:
             amp += g_in * gain * patch_amplitude(self.k, n2, d2, u2, v2, w_u, w_v, d2, s_out, r1 + r2 + l_out)
         amp *= np.sqrt(rho1 * q1 * rho2 * q2)
+        amp *= self._return_gain(d, s_d)
         return amp, (r1 + r2 + l_d) / 2.0, keep
+
+    def _return_gain(self, d_in: np.ndarray, s_back: np.ndarray) -> np.ndarray:
+        """(M,) complex one-way horizontal gain of a second bounce's return leg off the incident ray's azimuth.
+
+        The echo is placed on its incident ray's spoke and the beam sum gives it the two-way pattern about
+        that direction, as if it came back the way it went. It comes back from the second patch: seen from the
+        antenna at azimuth ``Delta`` off the incident ray, it is received with ``g_h(Delta)`` (one way), at the
+        main lobe only when both patches lie in the beam (a corner of one object), through a sidelobe when they
+        do not (a quay seen across a basin from another quay).
+
+        Parameters
+        ----------
+        d_in : (M,) 3-vectors
+            Unit directions of the incident rays (antenna -> first patch), world frame.
+        s_back : (M,) 3-vectors
+            Unit directions second patch -> antenna, world frame.
+        """
+        az_in = np.degrees(np.arctan2(d_in[:, 0], d_in[:, 1]))
+        az_back = np.degrees(np.arctan2(-s_back[:, 0], -s_back[:, 1]))
+        return self.r.pattern.horizontal_voltage(az_back - az_in)
 
     # ------------------------------------------------------------------ sum, range and beam
 

@@ -89,3 +89,28 @@ def test_a_ships_peak_echo_scintillates_from_scan_to_scan(tmp_path):
                  duration=52.0)
     peaks_db = np.array([10 * np.log10(r.revolution(rev).target_snr.max()) for rev in range(20)])
     assert np.std(peaks_db) >= 4.0
+
+
+def test_a_second_bounce_returning_from_off_the_beam_is_received_through_the_sidelobe(tmp_path, monkeypatch):
+    """Two plates 200 m apart at bearings 0 and 45 deg, turned so that a ray going north bounces off the first to the
+    second and from there straight back to the antenna (and the reverse path): the echo is placed on the incident
+    ray's spoke at half the path (341 m), but returns from 45 deg off it, so it is received with the one-way gain
+    there, |g_h(45 deg)|, not the main lobe's (a quay seen across a basin from another quay)."""
+    def plate(name, east_m, north_m, heading_deg):
+        mesh = box_file(tmp_path, name, (10.0, 0.05, 8.0), (0.0, 0.0, 4.0))
+        return {"name": name, "kind": "mesh", "mesh": mesh, "material": "aluminium",
+                "position": latlon(east_m, north_m), "heading_deg": heading_deg}
+
+    def ghost_db(name):
+        r = renderer(tmp_path, name, obstacles=[plate("a", 0.0, 200.0, 45.0), plate("b", 200.0, 200.0, 157.5)],
+                     resolve_m=0.5, elevation_max_deg=1.0, elevation_min_deg=-1.0)
+        j = int(round((200.0 + 200.0 + 200.0 * np.sqrt(2.0)) / 2.0 / r.dr))
+        return 10 * np.log10(r.revolution(0).target_snr[:, j - 6: j + 7].max()), r.pattern
+
+    received, pattern = ghost_db("through_sidelobe")
+    from raysim.sensors import radar_targets
+    monkeypatch.setattr(radar_targets.TargetEchoes, "_return_gain", lambda self, d, s: np.ones(len(d), complex))
+    main_lobe, _ = ghost_db("as_if_main_lobe")
+    sidelobe_db = 20 * np.log10(abs(pattern.horizontal_voltage(np.array(45.0))))
+    assert sidelobe_db < -20.0
+    assert received - main_lobe == pytest.approx(sidelobe_db, abs=2.0)
