@@ -98,8 +98,11 @@ def _recording_result(recording: Path, workdir: Path, config: TdmConfig, counts:
             "duration_s": float(read_manifest(recording).get("duration_s")), "rate_hz": config.update_rate_hz}
 
 
-def tune(recording: Path, workdir: Path, budget_scale: float = 1.0) -> tuple[dict, dict, Context, dict]:
+def tune(recording: Path, workdir: Path, budget_scale: float = 1.0, done: dict | None = None) \
+        -> tuple[dict, dict, Context, dict]:
     """Tune every Stone Soup tracker on ``recording`` (time budgets :data:`BUDGET_S` times ``budget_scale``).
+
+    ``done``: {(algorithm, name): (setting, trail)} already tuned (by a cut run, :func:`read_log`).
 
     Returns
     -------
@@ -124,6 +127,9 @@ def tune(recording: Path, workdir: Path, budget_scale: float = 1.0) -> tuple[dic
     trails: dict = {a: {} for a in ALGORITHMS}
     for algorithm in ALGORITHMS:
         for name in TRACKER_SENSORS:
+            if (algorithm, name) in (done or {}):
+                chosen[algorithm][name], trails[algorithm][name] = done[(algorithm, name)]
+                continue
             t0 = time.perf_counter()
             central = name.startswith("central")
             start = chosen[algorithm]["radar"] if central else start_setting(algorithm, name, config)
@@ -141,6 +147,25 @@ def tune(recording: Path, workdir: Path, budget_scale: float = 1.0) -> tuple[dic
     result["wall_s"] = {a: {n: runner.walls[(n, s)] for n, s in chosen[a].items()} for a in ALGORITHMS}
     result["runs"] = len(runner.cache)
     return result, chosen, ctx, trails
+
+
+def read_log(path: Path) -> dict:
+    """The trackers a cut run tuned, from its printed log: {(algorithm, name): (setting, trail)}.
+
+    The trail is the points the log printed (the start point's GOSPA is not printed: its first
+    entry is the start value of the first parameter, or for centralised trackers missing).
+    """
+    done, trails = {}, {}
+    for line in path.read_text(encoding="utf-8").splitlines():
+        words = line.split()
+        if line.startswith("  ") and len(words) >= 5 and words[3] == "GOSPA":
+            parameter, value = words[2].rstrip(":").split("=", 1)
+            parsed = None if value == "None" else (int(value) if parameter == "min_points" else float(value))
+            trails.setdefault((words[0], words[1]), []).append((parameter, parsed, float(words[4])))
+        elif line.startswith("tuned "):
+            setting = eval(line.split(": ", 1)[1], {"Setting": Setting})  # our own repr of a Setting
+            done[(words[1], words[2])] = (setting, trails.get((words[1], words[2]), []))
+    return done
 
 
 def held_out(recording: Path, workdir: Path, chosen: dict, ctx: Context) -> dict:
@@ -162,7 +187,8 @@ def publish_figures(figures: dict, out: Path, json_path: Path | None) -> None:
     import stonesoup
 
     intro = intro_lines(results, TUNING[0], ctx, figures.get("quick", False),
-                        figures.get("stonesoup_version", stonesoup.__version__), figures["total_s"])
+                        figures.get("stonesoup_version", stonesoup.__version__), figures["total_s"],
+                        figures.get("run_note", ""))
     notes = note_lines(results, TUNING[0], chosen, figures["trails"], ctx)
     publish("Our trackers against tuned Stone Soup trackers (GNN and JPDA): the same detections and information",
             intro, summary_rows(results), out, json_path, figures, notes)
@@ -179,6 +205,7 @@ def main(argv=None) -> int:
     parser.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results" / "stonesoup_compare.md")
     parser.add_argument("--json", type=Path, help="also write the figures as JSON")
     parser.add_argument("--budget-scale", type=float, default=1.0, help="multiply the tuning time budgets (BUDGET_S)")
+    parser.add_argument("--resume-log", type=Path, help="take the trackers a cut run tuned from its printed log")
     parser.add_argument("--from-json", type=Path, help="only write the results file from a run's --json figures")
     args = parser.parse_args(argv)
     if args.from_json:
@@ -197,7 +224,8 @@ def main(argv=None) -> int:
     results: dict = {}
     tuning_rec = recording(*TUNING)
     results[TUNING[0]], chosen, ctx, trails = tune(tuning_rec, args.workdir / f"{TUNING[1]}{suffix}_compare",
-                                                   args.budget_scale)
+                                                   args.budget_scale,
+                                                   read_log(args.resume_log) if args.resume_log else None)
     import stonesoup
 
     def write() -> None:

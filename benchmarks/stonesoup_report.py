@@ -41,12 +41,17 @@ def summary_rows(results: dict) -> list[tuple[str, str]]:
             for scenario, res in results.items() for side, a, n, label in COLUMNS]
 
 
-def intro_lines(results: dict, tuning: str, ctx: Context, quick: bool, version: str, total_s: float) -> list[str]:
-    """The opening paragraphs: recordings, metric, what Stone Soup is given and how it is tuned."""
+def intro_lines(results: dict, tuning: str, ctx: Context, quick: bool, version: str, total_s: float,
+                run_note: str = "") -> list[str]:
+    """The opening paragraphs: recordings, metric, what Stone Soup is given and how it is tuned.
+
+    ``run_note``: how the run went, in place of its wall time (a run resumed from a cut one).
+    """
     first = results[tuning]
     dens = ctx.clutter_density_per_m2
     return [
-        machine_line("stonesoup_compare", quick) + f" Stone Soup {version}. Whole benchmark: {total_s / 60:.0f} min.",
+        machine_line("stonesoup_compare", quick) + f" Stone Soup {version}. "
+        + (run_note or f"Whole benchmark: {total_s / 60:.0f} min."),
         "",
         "Recordings: " + "; ".join(
             f"`scenarios/{s}.yaml` rendered with `raysim render --duration {r['duration_s']:g}` ("

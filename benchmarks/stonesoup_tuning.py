@@ -241,8 +241,9 @@ class Runner:
     def evaluated(self, name: str, setting: Setting) -> dict:
         """Metrics of an already run (tracker, setting) from :func:`tdm.evaluate.evaluate` itself."""
         key = (name, setting)
+        fast = self.metrics(name, setting)  # runs it when not yet run (a resumed tuning)
         if not self.fast:
-            return self.metrics(name, setting)
+            return fast
         with open(self.files[key], encoding="utf-8") as handle:
             records = [json.loads(line) for line in handle]
         return score_records(self.recording, self.workdir / f"ss_{setting.algorithm}_{name}", records)
