@@ -4,9 +4,12 @@ Usage::
 
     python benchmarks/stonesoup_compare.py [--quick] [--workdir /tmp/ss_work] [--duration 120] [--fresh]
                                            [--heldout crossing_silent_ship rough_sea_rain] [--json FILE]
+                                           [--budget-scale 1] [--resume-log LOG] [--from-json FILE]
                                            [--out benchmarks/results/stonesoup_compare.md]
 
 ``--quick``: 30 s recordings, one held-out recording. ``--fresh``: render the recordings again.
+``--resume-log``: take the trackers a cut run tuned from its printed output. ``--from-json``: only
+rewrite the results file from a run's ``--json`` figures.
 
 Recordings are rendered with ``raysim render`` into ``WORKDIR/ss_<short name>`` unless already
 there with the asked duration. The tuning recording is busy_open_sea (the one ours was tuned
