@@ -1,7 +1,7 @@
 """Our trackers against the tuned Stone Soup trackers (benchmarks/stonesoup_compare.py), on held-out data.
 
-Marked ``bench`` (not run by the default test command; renders 120 s of crossing_silent_ship, about
-3 min, then runs ``tdm run`` and six Stone Soup trackers, a few minutes more). The Stone Soup
+Marked ``bench`` (not run by the default test command; renders 120 s of crossing_silent_ship, then
+runs ``tdm run`` and six Stone Soup trackers: 3.3 min in all on 2 cores). The Stone Soup
 settings are the ones the benchmark chose on busy_open_sea (read from
 benchmarks/results/stonesoup_compare.md, unchanged); the test scores ours and them on the held-out
 crossing with ``tdm.evaluate.evaluate`` and asserts the ordering the benchmark's held-out table shows.
