@@ -110,8 +110,13 @@ def test_position_packets_arrive_once_a_second_with_a_gprmc(session):
     assert len(packets) in (10, 11)
     assert all(len(p) == 512 for p in packets)
     assert all(b"$GPRMC" in p for p in packets)
-    gaps = np.diff(rx["lidar_position"].times)
-    assert np.all(np.abs(gaps - 1.0) < 0.05)
+    times = np.asarray(rx["lidar_position"].times)
+    gaps = np.diff(times)
+    assert np.median(np.abs(gaps - 1.0)) < 0.01
+    # on an absolute schedule: a stall of the VM delays one packet (up to 0.2 s: one in about five runs on this
+    # 2-core VM under load, 0.137 s once) without shifting the next, so the span stays (n - 1) s
+    assert np.all(np.abs(gaps - 1.0) < 0.2)
+    assert times[-1] - times[0] == pytest.approx(gaps.size, abs=0.05)
 
 
 def test_radar_spokes_parse_as_radar_pi_reads_them_at_the_set_rate(session):
