@@ -289,16 +289,7 @@ class Fuser:
                     self.targets[-1].members = {sensor: tr.track_id}
         self._merge_overlapping(states, live)
         out = []
-        weigh = states
-        if cfg.weigh_extent:  # the output weighs each track with its centre's uncertainty (Track.reported)
-            weigh = dict(states)
-            for key, tr in live.items():
-                extra = tr.reported(t_s)[1][:2, :2] - tr.predicted(t_s)[1][:2, :2]
-                if np.any(extra):
-                    x_k, p_k = weigh[key]
-                    p_k = p_k.copy()
-                    p_k[:2, :2] += extra
-                    weigh[key] = (x_k, p_k)
+        weigh = self._with_extent(states, live) if cfg.weigh_extent else states
         for target in self.targets:
             x, p = self._estimate(target, weigh)
             target.last_x, target.last_t_s, target.radius_m = x, t_s, self._half_length(target, live)
@@ -307,6 +298,19 @@ class Fuser:
             heights = [live[(s, i)].height_m for s, i in target.members.items() if s == "lidar"]
             self._classify(target, x, p, t_s, heights[0] if heights else float("nan"))
             out.append(FusedEstimate(target, x, p, sorted(target.members)))
+        return out
+
+    @staticmethod
+    def _with_extent(states: dict, live: dict) -> dict:
+        """``states`` with each track's centre uncertainty behind the side seen (:attr:`Track.extent_var_m2`) added
+        to its position covariance: what the output weighs with ``weigh_extent``."""
+        out = dict(states)
+        for key, tr in live.items():
+            if tr.extent_var_m2 > 0.0:
+                x, p = states[key]
+                p = p.copy()
+                p[:2, :2] += tr.extent_var_m2 * np.eye(2)
+                out[key] = (x, p)
         return out
 
     def _behind_the_face(self, states: dict, live: dict, own_m: np.ndarray) -> None:

@@ -181,10 +181,18 @@ class Track:
         (``extent_sigma_fraction`` of ``length_m`` per axis, :class:`TrackerConfig`) added to the position's
         covariance: what the track reports in ``sensor_tracks.jsonl``."""
         x, p = self.predicted(t_s)
-        if self.extent_sigma_fraction > 0.0 and np.isfinite(self.length_m) and self.length_m > 0.0:
+        if self.extent_var_m2 > 0.0:
             p = p.copy()
-            p[:2, :2] += (self.extent_sigma_fraction * self.length_m) ** 2 * np.eye(2)
+            p[:2, :2] += self.extent_var_m2 * np.eye(2)
         return x, p
+
+    @property
+    def extent_var_m2(self) -> float:
+        """Variance per axis of the object's centre behind the side seen, m^2: ``(extent_sigma_fraction length_m)^2``
+        (0 without a fraction or a finite positive length)."""
+        if self.extent_sigma_fraction > 0.0 and np.isfinite(self.length_m) and self.length_m > 0.0:
+            return float((self.extent_sigma_fraction * self.length_m) ** 2)
+        return 0.0
 
 
 class PositionTracker:

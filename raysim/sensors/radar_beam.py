@@ -136,18 +136,7 @@ def convolve_cells_compact(values: np.ndarray, flat: np.ndarray, shape: tuple[in
     A coast paints on every spoke, so M is all spokes while the cells reached are a few per cent of (M, N): the
     dense output's zeros would cost more than the sums. Each reached cell's sum is taken over its contributions in
     the same order and in float64 as a dense ``np.bincount`` would, so the values equal :func:`convolve_cells`'s
-    bit for bit.
-
-    Parameters
-    ----------
-    values : (Q,) float or complex
-        The non-zero cells' values.
-    flat : (Q,) int
-        Their flat indices in the (M, N) array (distinct).
-    shape : (int, int)
-        M, N.
-    kernel : (L,) float
-        Centred kernel, L odd.
+    bit for bit. Parameters as :func:`convolve_cells`.
 
     Returns
     -------
