@@ -8,6 +8,13 @@
   gives for the member, or beyond :data:`MAX_ARRAY_BYTES`, is refused before anything is allocated.
 * :func:`load_arrays` then reads the asked members into arrays of exactly that checked size.
 
+A file of up to :data:`IN_MEMORY_MAX_BYTES` is read in one system call and its stored (uncompressed)
+members, which is how ``np.savez`` and raysim write them, are taken from those bytes: the member's
+place from its local header, its CRC-32 checked as ``zipfile`` checks it, and its ``.npy`` header read
+by a fast parser of numpy's own header text (anything else goes to numpy's parser). Compressed
+members and larger files go through ``zipfile``'s streams. Both routes give the same arrays and the
+same errors (tests/tdm/test_recording.py).
+
 A file that cannot be read as such an archive at all (zero bytes, not a zip, cut short, damaged
 member data or header) raises :class:`Unreadable` with a short reason: what copying or a crash
 leaves, which callers count as a warning. A path that is not a readable regular file raises
@@ -21,6 +28,7 @@ import functools
 import io
 import math
 import os
+import re
 import zipfile
 import zlib
 from dataclasses import dataclass
@@ -31,12 +39,22 @@ import numpy as np
 from tdm.errors import RecordingError
 from tdm.recording.files import regular_file
 
-__all__ = ["ArrayHeader", "NpzFile", "Unreadable", "read_layout", "load_arrays", "MAX_ARRAY_BYTES"]
+__all__ = ["ArrayHeader", "NpzFile", "Unreadable", "read_layout", "load_arrays", "MAX_ARRAY_BYTES",
+           "IN_MEMORY_MAX_BYTES"]
 
 #: Largest array accepted in a sweep file, bytes (a radar sweep's echo is 2 MiB, a LiDAR sweep's x 0.3 MiB).
 MAX_ARRAY_BYTES = 1 << 30
 #: Longest ``.npy`` header text accepted, bytes (numpy writes 128 and refuses to read over 10,000).
 MAX_HEADER_BYTES = 1 << 16
+#: Files up to this size are read whole, in one system call (a radar sweep is 2 MiB, a LiDAR sweep 0.6 MiB).
+IN_MEMORY_MAX_BYTES = 1 << 28
+#: A zip local file header: its signature and fixed length; the name and extra field lengths at 26 and 28.
+_LOCAL_HEADER_SIGNATURE = b"PK\x03\x04"
+_LOCAL_HEADER_BYTES = 30
+#: The header text numpy writes (``np.lib.format``): ``{'descr': '<f4', 'fortran_order': False, 'shape': (3,), }``
+#: padded with spaces to a newline. Texts of another form go to numpy's parser.
+_NUMPY_HEADER_TEXT = re.compile(rb"\{'descr': '([<>|=]?[biufc]\d{1,2})', 'fortran_order': (True|False), "
+                                rb"'shape': \(((?:\d+, )*\d+,?|)\), \} *\n")
 _ZIP_ERRORS = (zipfile.BadZipFile, zlib.error, EOFError, OSError, ValueError, NotImplementedError, RuntimeError,
                KeyError)
 
@@ -90,17 +108,19 @@ class ArrayHeader:
         return math.prod(self.shape) * self.dtype.itemsize
 
 
-def _open_zip(path: Path) -> zipfile.ZipFile:
+def _open_zip(path: Path) -> tuple[zipfile.ZipFile, bytes | None]:
+    """The archive, and the file's bytes when it is small enough to be read whole (else None)."""
     regular_file(path)
     size = os.stat(path).st_size
     if size == 0:
         raise Unreadable(ZERO_BYTES)
     with open(path, "rb") as handle:
-        magic = handle.read(2)
+        data = handle.read() if size <= IN_MEMORY_MAX_BYTES else None
+        magic = data[:2] if data is not None else handle.read(2)
     if magic != b"PK":
         raise Unreadable(NOT_A_ZIP)
     try:
-        return zipfile.ZipFile(path)
+        return zipfile.ZipFile(io.BytesIO(data) if data is not None else path), data
     except _ZIP_ERRORS:
         raise Unreadable(CUT_SHORT) from None
 
@@ -110,6 +130,11 @@ def _decode_header(raw: bytes) -> tuple[tuple[int, ...], bool, np.dtype] | tuple
     """(shape, fortran order, dtype) of a ``.npy`` header's bytes (magic to the end of the header text),
     or the format version when it is neither 1.0 nor 2.0. Cached: the arrays of a sweep, and of the
     sweeps of a run, repeat the same few headers."""
+    if raw[:7] == b"\x93NUMPY\x01":
+        text = _NUMPY_HEADER_TEXT.fullmatch(raw, 10)
+        if text is not None:
+            shape = tuple(int(n) for n in text.group(3).split(b",") if n.strip())
+            return shape, text.group(2) == b"True", np.dtype(text.group(1).decode("ascii"))
     fp = io.BytesIO(raw)
     version = np.lib.format.read_magic(fp)
     if version == (1, 0):
@@ -153,12 +178,67 @@ def _parse_header(fp, info: zipfile.ZipInfo, path: Path) -> ArrayHeader:
     return header
 
 
-def _member_header(zf: zipfile.ZipFile, info: zipfile.ZipInfo, path: Path) -> ArrayHeader:
+def _member_header(zf: zipfile.ZipFile, info: zipfile.ZipInfo, path: Path, data: bytes | None) -> ArrayHeader:
     try:
+        stored = _stored_member(data, info, check_crc=False)  # the data is not read: as zipfile, no CRC
+        if stored is not None:
+            return _parse_header(stored, info, path)
         with zf.open(info) as fp:
             return _parse_header(fp, info, path)
     except _ZIP_ERRORS:
         raise Unreadable(DAMAGED, f"array {info.filename[:-4]!r}") from None
+
+
+class _MemberView:
+    """A read-only stream over a member's bytes in memory (``read``, ``readinto``), without copying them."""
+
+    def __init__(self, view: memoryview):
+        self._view, self._at = view, 0
+
+    def read(self, n: int = -1) -> bytes:
+        end = len(self._view) if n < 0 else min(self._at + n, len(self._view))
+        chunk = bytes(self._view[self._at:end])
+        self._at = end
+        return chunk
+
+    def readinto(self, buffer: memoryview) -> int:
+        n = min(len(buffer), len(self._view) - self._at)
+        buffer[:n] = self._view[self._at:self._at + n]
+        self._at += n
+        return n
+
+    def __enter__(self) -> "_MemberView":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self._view.release()
+
+
+def _stored_member(data: bytes | None, info: zipfile.ZipInfo, check_crc: bool = True) -> _MemberView | None:
+    """A stored (uncompressed) member of an archive read whole, as a stream over its bytes, its
+    CRC-32 checked (unless ``check_crc`` is false); None for a compressed member or an archive not in
+    memory.
+
+    Raises
+    ------
+    zipfile.BadZipFile
+        The local header is not where the directory says, the member runs past the file's end, or its
+        CRC-32 is not the directory's (what ``zipfile`` raises for the same faults).
+    """
+    if data is None or info.compress_type != zipfile.ZIP_STORED:
+        return None
+    at = info.header_offset
+    local = data[at:at + _LOCAL_HEADER_BYTES]
+    if len(local) != _LOCAL_HEADER_BYTES or local[:4] != _LOCAL_HEADER_SIGNATURE:
+        raise zipfile.BadZipFile("no local file header where the directory points")
+    start = at + _LOCAL_HEADER_BYTES + int.from_bytes(local[26:28], "little") + int.from_bytes(local[28:30], "little")
+    end = start + info.compress_size
+    if end > len(data):
+        raise zipfile.BadZipFile("member runs past the end of the file")
+    member = memoryview(data)[start:end]
+    if check_crc and zlib.crc32(member) != info.CRC:
+        raise zipfile.BadZipFile(f"bad CRC-32 for {info.filename}")
+    return _MemberView(member)
 
 
 class NpzFile:
@@ -176,16 +256,16 @@ class NpzFile:
 
     def __init__(self, path: Path, preload: tuple[str, ...] = ()):
         self.path = Path(path)
-        self._zf = _open_zip(self.path)
+        self._zf, self._data = _open_zip(self.path)
         self._loaded: dict[str, np.ndarray] = {}
         try:
             self._infos = {info.filename[:-4]: info for info in self._zf.infolist() if info.filename.endswith(".npy")}
             self.layout = {}
             for name, info in self._infos.items():
                 if name in preload:
-                    self.layout[name], self._loaded[name] = _read_member(self._zf, info, self.path)
+                    self.layout[name], self._loaded[name] = _read_member(self._zf, info, self.path, self._data)
                 else:
-                    self.layout[name] = _member_header(self._zf, info, self.path)
+                    self.layout[name] = _member_header(self._zf, info, self.path, self._data)
         except BaseException:
             self._zf.close()
             raise
@@ -195,11 +275,12 @@ class NpzFile:
         missing = [n for n in names if n not in self._infos]
         if missing:
             raise RecordingError(str(self.path), missing[0], "array missing")
-        return {n: self._loaded[n] if n in self._loaded else _read_member(self._zf, self._infos[n], self.path)[1]
-                for n in names}
+        return {n: self._loaded[n] if n in self._loaded
+                else _read_member(self._zf, self._infos[n], self.path, self._data)[1] for n in names}
 
     def close(self) -> None:
         self._zf.close()
+        self._data = None
 
     def __enter__(self) -> "NpzFile":
         return self
@@ -222,9 +303,11 @@ def read_layout(path: Path) -> dict[str, ArrayHeader]:
         return npz.layout
 
 
-def _read_member(zf: zipfile.ZipFile, info: zipfile.ZipInfo, path: Path) -> tuple[ArrayHeader, np.ndarray]:
+def _read_member(zf: zipfile.ZipFile, info: zipfile.ZipInfo, path: Path,
+                 data: bytes | None = None) -> tuple[ArrayHeader, np.ndarray]:
     try:
-        with zf.open(info) as fp:
+        stored = _stored_member(data, info)
+        with stored if stored is not None else zf.open(info) as fp:
             header = _parse_header(fp, info, path)
             flat = np.empty(math.prod(header.shape), dtype=header.dtype)  # size checked against the archive
             view = memoryview(flat.view(np.uint8)) if header.nbytes else memoryview(bytearray(0))

@@ -12,6 +12,7 @@ import pytest
 from tdm.detections import ReadStats
 from tdm.errors import RecordingError
 from tdm.pipeline import _EpochTimes
+from tdm.recording import npz as npz_module
 from tdm.recording.npz import NpzFile, Unreadable, load_arrays, read_layout
 from tdm.recording.pcap_times import BACK, OUTSIDE, PacketClock
 from tdm.recording.values import integer, number
@@ -43,6 +44,62 @@ def test_arrays_read_as_np_load_reads_them(tmp_path):
                 assert np.array_equal(got[key], want[key]) and got[key].flags.writeable
                 assert got[key].flags.f_contiguous == want[key].flags.f_contiguous
         assert read_layout(tmp_path / name)["a"].shape == (3, 4)
+
+
+@pytest.mark.parametrize("in_memory", [True, False])
+def test_both_reading_routes_give_np_load_arrays(tmp_path, monkeypatch, in_memory):
+    """Small files are read whole and their stored members sliced out; larger ones go through zipfile."""
+    if not in_memory:
+        monkeypatch.setattr(npz_module, "IN_MEMORY_MAX_BYTES", 0)
+    arrays = {"f": np.linspace(0, 1, 7, dtype="<f4"), "d": np.arange(6, dtype=">f8").reshape(2, 3),
+              "u": np.arange(5, dtype=np.uint8), "b": np.array([True, False]), "z": np.array([1 + 2j]),
+              "s": np.float64(3.5), "t": np.array(["2026-11-27"], dtype="datetime64[ns]"),
+              "r": np.zeros(3, dtype=[("a", "<i4"), ("b", "<f8")])}
+    np.savez(tmp_path / "a.npz", **arrays)
+    got = load_arrays(tmp_path / "a.npz", tuple(arrays))
+    with np.load(tmp_path / "a.npz") as want:
+        for key in arrays:
+            assert got[key].dtype == want[key].dtype and got[key].shape == want[key].shape, key
+            assert np.array_equal(got[key], want[key]) and got[key].flags.writeable and got[key].flags.aligned
+
+
+def test_the_fast_header_parser_agrees_with_numpys():
+    for array in (np.zeros((), "<f8"), np.zeros(3, ">i2"), np.zeros((3, 4), "|u1"), np.zeros((2, 0, 5), "<c16"),
+                  np.asfortranarray(np.zeros((2, 3), "<f4")), np.zeros(1, "|b1"), np.zeros(2, "<M8[ns]")):
+        member = _npy(array)
+        raw = member[:10 + int.from_bytes(member[8:10], "little")]  # magic to the end of the header text
+        fp = io.BytesIO(raw)
+        np.lib.format.read_magic(fp)
+        assert npz_module._decode_header.__wrapped__(raw) == np.lib.format.read_array_header_1_0(fp), array.dtype
+
+
+def _central_directory_entry(content: bytes, name: bytes) -> int:
+    """Where the zip central directory's entry for member ``name`` starts."""
+    at = content.find(b"PK\x01\x02")
+    while content[at + 46:at + 46 + len(name)] != name:
+        at = content.find(b"PK\x01\x02", at + 4)
+    return at
+
+
+@pytest.mark.parametrize("in_memory", [True, False])
+@pytest.mark.parametrize("fault", ["data", "crc", "local header"])
+def test_a_damaged_stored_member_is_unreadable_on_both_routes(tmp_path, monkeypatch, in_memory, fault):
+    if not in_memory:
+        monkeypatch.setattr(npz_module, "IN_MEMORY_MAX_BYTES", 0)
+    np.savez(tmp_path / "a.npz", y=np.arange(3), x=np.arange(1000, dtype=np.float64))  # x not at the start
+    content = bytearray((tmp_path / "a.npz").read_bytes())
+    with zipfile.ZipFile(tmp_path / "a.npz") as zf:
+        x_at = zf.getinfo("x.npy").header_offset
+    if fault == "data":  # a flipped byte inside x's data: its CRC-32 no longer matches
+        content[x_at + 2000] ^= 0xFF
+    elif fault == "crc":  # the central directory's CRC-32 of x changed
+        content[_central_directory_entry(bytes(content), b"x.npy") + 16] ^= 0xFF
+    else:  # x's local header overwritten
+        content[x_at:x_at + 4] = b"\0\0\0\0"
+    (tmp_path / "b.npz").write_bytes(bytes(content))
+    with pytest.raises(Unreadable) as caught:
+        load_arrays(tmp_path / "b.npz", ("x", "y"))
+    assert caught.value.reason == "damaged array data" and "'x'" in caught.value.detail
 
 
 def _npy_claiming(data: np.ndarray, shape_text: str) -> bytes:
