@@ -87,11 +87,12 @@ The settings are :class:`LidarFrontEndConfig` (:mod:`tdm.frontend.lidar_config`)
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.sparse import csr_matrix
+from scipy.sparse import csr_array
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
@@ -307,9 +308,9 @@ def lidar_clusters(sweep: dict[str, np.ndarray], track: OwnshipTrack, mount: Mou
 def _off_ship(x: np.ndarray, y: np.ndarray, z: np.ndarray, mount: Mount, config: LidarFrontEndConfig) -> np.ndarray:
     """Indices of the points outside the own ship's body-frame column (step 1), in the sweep's own
     precision (float32)."""
-    rot = mount.rotation()
+    rot, _, identity = _mount_pose(mount)
     dx = mount.x_m - config.ownship_centre_x_m
-    if np.allclose(rot, np.eye(3), rtol=0.0, atol=_IDENTITY_ATOL):
+    if identity:
         body_x, body_y = x + dx, y + mount.y_m
     else:
         body_x = rot[0, 0] * x + rot[0, 1] * y + rot[0, 2] * z + dx
@@ -317,6 +318,15 @@ def _off_ship(x: np.ndarray, y: np.ndarray, z: np.ndarray, mount: Mount, config:
     half_length = 0.5 * config.ownship_length_m + config.ownship_margin_m
     half_beam = 0.5 * config.ownship_beam_m + config.ownship_margin_m
     return np.nonzero((np.abs(body_x) > half_length) | (np.abs(body_y) > half_beam))[0]
+
+
+@functools.lru_cache(maxsize=16)
+def _mount_pose(mount: Mount) -> tuple[np.ndarray, np.ndarray, bool]:
+    """A mount's (3, 3) sensor-to-body rotation and (3,) translation (m), read-only, and whether the
+    rotation is the identity: formed once per mount, not once per sweep."""
+    rotation, translation = mount.rotation(), mount.translation_m()
+    rotation.flags.writeable = translation.flags.writeable = False
+    return rotation, translation, bool(np.allclose(rotation, np.eye(3), rtol=0.0, atol=_IDENTITY_ATOL))
 
 
 def _good_returns(idx: np.ndarray, x: np.ndarray, y: np.ndarray, z: np.ndarray, time_s: np.ndarray,
@@ -356,9 +366,18 @@ def _cluster_labels(inverse: np.ndarray, centres: np.ndarray, ring: np.ndarray, 
     between = link_i != link_j
     rows = np.concatenate([pairs[:, 0], link_i[between]])
     cols = np.concatenate([pairs[:, 1], link_j[between]])
-    graph = csr_matrix((np.ones(rows.shape[0]), (rows, cols)), shape=(n_voxels, n_voxels))
-    _, voxel_label = connected_components(graph, directed=False)
+    _, voxel_label = connected_components(_adjacency(rows, cols, n_voxels), directed=False)
     return voxel_label[inverse], on_surface
+
+
+def _adjacency(rows: np.ndarray, cols: np.ndarray, n: int) -> csr_array:
+    """(n, n) sparse adjacency of the edges ``rows[k] -> cols[k]`` (E,), built straight in CSR form (edges
+    sorted by row, a row pointer from their counts): the graph ``csr_array((ones, (rows, cols)))`` gives,
+    without its COO detour. Repeated edges stay repeated, which connected components do not mind."""
+    order = np.argsort(rows, kind="stable")
+    indptr = np.zeros(n + 1, dtype=np.int32)
+    np.cumsum(np.bincount(rows, minlength=n), out=indptr[1:])
+    return csr_array((np.ones(rows.shape[0]), cols[order].astype(np.int32), indptr), shape=(n, n))
 
 
 def _kept_clusters(label: np.ndarray, on_surface: np.ndarray, config: LidarFrontEndConfig
@@ -478,7 +497,8 @@ def _sensor_to_enu(track: OwnshipTrack, points_sensor_m: np.ndarray, t_s: np.nda
         return track.sensor_to_enu(points_sensor_m, t_s, mount)
     node = np.rint((t_s - t0) / step_s).astype(np.intp)
     node_t = t0 + step_s * np.arange(n_nodes)
-    body = points_sensor_m @ mount.rotation().T + mount.translation_m()
+    rotation, translation, _ = _mount_pose(mount)
+    body = points_sensor_m @ rotation.T + translation
     return np.einsum("nij,nj->ni", track.rotation(node_t)[node], body) + track.position_m(node_t)[node]
 
 

@@ -340,3 +340,30 @@ def test_busy_open_sea_every_well_seen_object_gives_a_cluster_near_it(bos_record
             assert len(det) and np.hypot(*(det.position_m - truth).T).min() < 10.0, (t, object_id)
             checked += 1
     assert checked > 200
+
+
+def test_the_adjacency_built_in_csr_form_is_the_coo_built_graph():
+    from scipy.sparse import csr_array
+    from scipy.sparse.csgraph import connected_components
+
+    from tdm.frontend.lidar import _adjacency
+
+    rng = np.random.default_rng(5)
+    rows, cols = rng.integers(0, 60, 80), rng.integers(0, 60, 80)
+    rows[:5] = cols[:5] = 7  # self loops and repeated edges
+    direct = _adjacency(rows, cols, 60)
+    via_coo = csr_array((np.ones(80), (rows, cols)), shape=(60, 60))
+    assert np.array_equal(direct.toarray(), via_coo.toarray())
+    assert np.array_equal(connected_components(direct, directed=False)[1],
+                          connected_components(via_coo, directed=False)[1])
+
+
+def test_a_mount_pose_is_formed_once_and_is_the_mounts():
+    from tdm.frontend.lidar import _mount_pose
+
+    mount = Mount(x_m=1.0, z_m=3.0, roll_deg=2.0, yaw_deg=-4.0)
+    rotation, translation, identity = _mount_pose(mount)
+    assert _mount_pose(Mount(x_m=1.0, z_m=3.0, roll_deg=2.0, yaw_deg=-4.0))[0] is rotation
+    assert np.array_equal(rotation, mount.rotation()) and np.array_equal(translation, mount.translation_m())
+    assert not identity and _mount_pose(Mount(x_m=1.0))[2]
+    assert not rotation.flags.writeable
