@@ -21,12 +21,15 @@ semi-definite under rounding.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 N_STATES = 6
 E, N, PSI, U, R, ALPHA = range(N_STATES)
+_EYE = np.eye(N_STATES)
+_TWO_PI = 2 * np.pi
 
 
 @dataclass(frozen=True)
@@ -62,6 +65,24 @@ def wrap_pi(angle_rad):
 
 def transition(x: np.ndarray, dt_s: float) -> tuple[np.ndarray, np.ndarray]:
     """Propagate one state over ``dt_s``: the predicted state (6,) and the Jacobian F (6, 6)."""
+    e, n, psi, u, r, alpha = x.tolist()
+    dt = float(dt_s)
+    if not math.isfinite(psi + u + r + dt):
+        return _transition_array(x, dt_s)
+    # the same operations, in the same order, as _transition_array on Python floats (math.sin and math.cos
+    # are numpy's, bit for bit: tests/tdm/test_ekf.py)
+    mid = psi + 0.5 * r * dt
+    s, c = math.sin(mid), math.cos(mid)
+    out = np.array([e + dt * u * s, n + dt * u * c, (psi + r * dt + math.pi) % _TWO_PI - math.pi, u, r, alpha])
+    f = _EYE.copy()
+    f[E, PSI], f[E, U], f[E, R] = dt * u * c, dt * s, 0.5 * dt * dt * u * c
+    f[N, PSI], f[N, U], f[N, R] = -dt * u * s, dt * c, -0.5 * dt * dt * u * s
+    f[PSI, R] = dt
+    return out, f
+
+
+def _transition_array(x: np.ndarray, dt_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`transition` in numpy operations (the reference; used for non-finite states)."""
     psi, u, r = x[PSI], x[U], x[R]
     mid = psi + 0.5 * r * dt_s
     s, c = np.sin(mid), np.cos(mid)
@@ -98,7 +119,62 @@ def process_covariance(x: np.ndarray, dt_s: float, q: ProcessNoise) -> np.ndarra
     The linearised dynamics are nilpotent (A^3 = 0: turn rate drives course, course and speed
     drive position), so e^(A s) = I + A s + A^2 s^2 / 2 and the integral is a polynomial in dt,
     evaluated exactly here; it equals Van Loan's matrix-exponential form (tests/tdm/test_ekf.py).
+
+    The entries are formed one by one from the few non-zero ones of A (Python floats: the same
+    roundings as :func:`_process_covariance_array`, the matrix form, which tests/tdm/test_ekf.py checks
+    bit for bit); the one product with two terms per entry goes through the same matrix product as there.
     """
+    dt = abs(float(dt_s))
+    psi, u = float(x[PSI]), float(x[U])
+    if not math.isfinite(psi + u + dt):
+        return _process_covariance_array(x, dt_s, q)
+    q_pos, q_psi, q_u, q_r, q_alpha = (q.position_m2_per_s, q.course_rad2_per_s, q.speed_m2_per_s3,
+                                       q.turn_rate_rad2_per_s3, q.cross_section_m4_per_s)
+    dt2, dt3, dt4, dt5 = dt**2, dt**3, dt**4, dt**5
+    # A's non-zero entries (A[PSI, R] = 1); A^2's are A2[E, R] = a_ep, A2[N, R] = a_np
+    a_ep, a_eu, a_np, a_nu = u * math.cos(psi), math.sin(psi), -u * math.sin(psi), math.cos(psi)
+    aq_ep, aq_eu, aq_np, aq_nu = a_ep * q_psi, a_eu * q_u, a_np * q_psi, a_nu * q_u  # A Qc
+    a2q_er, a2q_nr = a_ep * q_r, a_np * q_r  # A^2 Qc
+    # 2 A Qc A^T: its east/north block sums two products (fused multiply-adds in BLAS: kept a matrix product)
+    two_aq = np.zeros((2, N_STATES))
+    two_aq[0, PSI], two_aq[0, U], two_aq[1, PSI], two_aq[1, U] = 2.0 * aq_ep, 2.0 * aq_eu, 2.0 * aq_np, 2.0 * aq_nu
+    a_en = np.zeros((2, N_STATES))
+    a_en[0, PSI], a_en[0, U], a_en[1, PSI], a_en[1, U] = a_ep, a_eu, a_np, a_nu
+    (m_ee, m_en), (m_ne, m_nn) = _block_product(two_aq, a_en).tolist()
+    out = {  # (row, column): the five terms of the polynomial, summed in the matrix form's order
+        (E, E): q_pos * dt + m_ee * dt3 / 6.0 + a2q_er * a_ep * dt5 / 20.0,
+        (N, N): q_pos * dt + m_nn * dt3 / 6.0 + a2q_nr * a_np * dt5 / 20.0,
+        (E, N): 0.0 + m_en * dt3 / 6.0 + a2q_er * a_np * dt5 / 20.0,
+        (N, E): 0.0 + m_ne * dt3 / 6.0 + a2q_nr * a_ep * dt5 / 20.0,
+        (E, PSI): 0.0 + aq_ep * dt2 / 2.0 + a2q_er * dt4 / 8.0,
+        (N, PSI): 0.0 + aq_np * dt2 / 2.0 + a2q_nr * dt4 / 8.0,
+        (E, U): 0.0 + aq_eu * dt2 / 2.0,
+        (N, U): 0.0 + aq_nu * dt2 / 2.0,
+        (E, R): 0.0 + a2q_er * dt3 / 6.0,
+        (N, R): 0.0 + a2q_nr * dt3 / 6.0,
+        (PSI, R): 0.0 + q_r * dt2 / 2.0,
+        (PSI, PSI): q_psi * dt + 2.0 * q_r * dt3 / 6.0,
+        (U, U): q_u * dt, (R, R): q_r * dt, (ALPHA, ALPHA): q_alpha * dt,
+    }
+    rows = [[0.0] * N_STATES for _ in range(N_STATES)]
+    for (i, j), value in out.items():  # 0.5 (out + out^T): every listed entry but (E, N) is symmetric as is
+        rows[i][j] = rows[j][i] = 0.5 * (value + out.get((j, i), value))
+    return np.array(rows)
+
+
+def _block_product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``a @ b.T`` of two (2, 6) matrices as rows of (6, 6) ones: the BLAS product of the matrix form.
+
+    Padded to (6, 6), so that BLAS runs the same kernel, with the same order of fused multiply-adds, as
+    in :func:`_process_covariance_array`.
+    """
+    full_a, full_b = np.zeros((N_STATES, N_STATES)), np.zeros((N_STATES, N_STATES))
+    full_a[:2], full_b[:2] = a, b
+    return (full_a @ full_b.T)[:2, :2]
+
+
+def _process_covariance_array(x: np.ndarray, dt_s: float, q: ProcessNoise) -> np.ndarray:
+    """:func:`process_covariance` as matrix products (the reference; used for non-finite states)."""
     dt = abs(dt_s)
     a, qc = continuous_dynamics(x), noise_density(q)
     a2 = a @ a
@@ -119,12 +195,23 @@ def predict(x: np.ndarray, p: np.ndarray, dt_s: float, q: ProcessNoise) -> tuple
 
 def velocity_en(x: np.ndarray) -> np.ndarray:
     """Velocity (..., 2) east, north in m/s of states (..., 6): speed along the course."""
+    if isinstance(x, np.ndarray) and x.shape == (N_STATES,):  # one state: Python floats, the same roundings
+        psi, u = float(x[PSI]), float(x[U])
+        if math.isfinite(psi):
+            return np.array([u * math.sin(psi), u * math.cos(psi)])
     x = np.asarray(x, dtype=float)
     return x[..., U, None] * np.stack([np.sin(x[..., PSI]), np.cos(x[..., PSI])], axis=-1)
 
 
 def predict_mean(x: np.ndarray, dt_s: np.ndarray) -> np.ndarray:
     """Predicted states (..., 6) of states (..., 6) over times (...,) s (no covariance; vectorised)."""
+    if isinstance(x, np.ndarray) and x.shape == (N_STATES,) and isinstance(dt_s, float):
+        e, n, psi, u, r, alpha = x.tolist()
+        dt = float(dt_s)
+        if math.isfinite(psi + r + dt):  # one state: Python floats, the same roundings as below
+            mid = psi + 0.5 * r * dt
+            return np.array([e + dt * u * math.sin(mid), n + dt * u * math.cos(mid),
+                             (psi + r * dt + math.pi) % _TWO_PI - math.pi, u, r, alpha])
     x = np.asarray(x, dtype=float)
     dt = np.asarray(dt_s, dtype=float)
     mid = x[..., PSI] + 0.5 * x[..., R] * dt

@@ -119,3 +119,39 @@ def test_speed_noise_grows_the_along_track_position_over_an_ais_gap():
     q_turn = ekf.ProcessNoise(position_m2_per_s=0.0, course_rad2_per_s=0.0, speed_m2_per_s3=0.0,
                               turn_rate_rad2_per_s3=1e-4, cross_section_m4_per_s=0.0)
     assert ekf.process_covariance(x, 10.0, q_turn)[ekf.E, ekf.E] == pytest.approx(25.0 * 1e-4 * 1e5 / 20.0)
+
+
+def _random_states(n: int, seed: int = 5) -> tuple[np.ndarray, np.ndarray]:
+    """n states (n, 6) and intervals (n,) s as the trackers meet them, with the edge cases (speed and course
+    exactly 0, negative speeds and intervals, wrapped courses) among them."""
+    rng = np.random.default_rng(seed)
+    x = np.column_stack([rng.normal(0, 500, n), rng.normal(0, 500, n), rng.uniform(-4, 4, n), rng.normal(0, 6, n),
+                         rng.normal(0, 0.03, n), rng.uniform(0, 500, n)])
+    x[::7, ekf.U] = 0.0
+    x[::5, ekf.PSI] = 0.0
+    x[::11, ekf.R] = 0.0
+    dt = rng.choice([-1.0, 1.0], n) * rng.exponential(2.0, n) * rng.choice([1e-3, 1.0, 20.0], n)
+    return x, dt
+
+
+def test_scalar_fast_paths_are_bit_identical_to_the_matrix_forms():
+    """transition, process_covariance, predict_mean and velocity_en of one state on Python floats give the very
+    bytes of the numpy matrix forms they replace (and would not if a rounding or a summation order changed)."""
+    q = ekf.ProcessNoise()
+    x, dt = _random_states(3000)
+    for xi, dti in zip(x, dt):
+        for d in (float(dti), np.float64(dti)):
+            out, f = ekf.transition(xi, d)
+            ref_out, ref_f = ekf._transition_array(xi, d)
+            assert out.tobytes() == ref_out.tobytes() and f.tobytes() == ref_f.tobytes()
+            assert ekf.process_covariance(xi, d, q).tobytes() == ekf._process_covariance_array(xi, d, q).tobytes()
+            assert ekf.predict_mean(xi, d).tobytes() == ekf.predict_mean(xi[None], np.array([d]))[0].tobytes()
+        assert ekf.velocity_en(xi).tobytes() == ekf.velocity_en(xi[None])[0].tobytes()
+
+
+def test_non_finite_states_take_the_matrix_forms():
+    x = np.array([1.0, 2.0, np.nan, 3.0, 0.0, 4.0])
+    q = ekf.ProcessNoise()
+    np.testing.assert_array_equal(ekf.process_covariance(x, 2.0, q), ekf._process_covariance_array(x, 2.0, q))
+    np.testing.assert_array_equal(ekf.transition(x, 2.0)[1], ekf._transition_array(x, 2.0)[1])
+    assert np.isnan(ekf.predict_mean(x, 2.0)[ekf.PSI])
