@@ -171,10 +171,22 @@ class Track:
     length_m: float = 0.0
     process: ekf.ProcessNoise = field(default_factory=ekf.ProcessNoise)
     extent_sigma_fraction: float = 0.0
+    _last_prediction: tuple | None = field(default=None, init=False, repr=False, compare=False)
 
     def predicted(self, t_s: float) -> tuple[np.ndarray, np.ndarray]:
-        """State (6,) and covariance (6, 6) predicted to ``t_s`` (the track is not changed)."""
-        return ekf.predict(self.x, self.p, t_s - self.t_s, self.process)
+        """State (6,) and covariance (6, 6) predicted to ``t_s`` (the track is not changed).
+
+        The last prediction is kept while the track's state, time and process noise stay the very objects
+        they were: the fusion and the output ask for the same epoch. The arrays are shared: not to be
+        changed in place.
+        """
+        last = self._last_prediction
+        if last is not None and last[0] == t_s and last[1] is self.x and last[2] is self.p and last[3] == self.t_s \
+                and last[4] is self.process:
+            return last[5]
+        out = ekf.predict(self.x, self.p, t_s - self.t_s, self.process)
+        self._last_prediction = (t_s, self.x, self.p, self.t_s, self.process, out)
+        return out
 
     def reported(self, t_s: float) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`predicted`, with the uncertainty of the object's centre behind the side the sensor sees
