@@ -29,9 +29,10 @@ Steps (numpy/scipy-vectorised; Python loops only over chunks of cells):
      training cells reach the lowest level L with ``alpha P(L) >= P(CUT)``, a count.
 
    Only cells that can pass at all are tested (level >= ``min_echo_level`` and power above
-   ``alpha x`` the floor): a few per cent of a sweep. For OS on video with N/2 a multiple of 8 the
-   counts are byte-parallel on 64-bit words (eight 4-bit levels compared at once, ``np.bitwise_count``);
-   otherwise the training cells are read through ``numpy.lib.stride_tricks.sliding_window_view`` (two
+   ``alpha x`` the floor): a few per cent of a sweep. For OS on video the counts of a CUT whose
+   training cells all lie on its spoke are byte-parallel on the sweep's aligned 64-bit words (eight
+   4-bit levels compared at once, the training bytes masked, one ``np.bitwise_count``); otherwise
+   the training cells are read through ``numpy.lib.stride_tricks.sliding_window_view`` (two
    contiguous halves per CUT) or, near the ends, a precomputed index table.
 
 3. Gap filling along range (:func:`fill_gaps`, :mod:`tdm.frontend.radar_plots`). An extended target (a ship end-on covers tens of samples) fills the
@@ -78,11 +79,11 @@ from scipy import ndimage
 
 from tdm.detections import Detections
 from tdm.frames import Mount, OwnshipTrack
-from tdm.frontend.radar_cfar import (VIDEO_LEVELS, _cfar_cells, _first_valid_sample, _lowest_candidate_level, cfar_mask,
-                                     training_table, video_power, video_power_table)
+from tdm.frontend.radar_cfar import (VIDEO_LEVELS, _cfar_cells, _first_valid_sample, _lowest_candidate_level, _nonzero_flat,
+                                     cfar_mask, training_table, video_power, video_power_table)
 from tdm.frontend.radar_clutter import _integrate_cells, _margin_over_clutter_db, beam_integrated_power, clutter_map
 from tdm.frontend.radar_config import RadarFrontEndConfig, ca_alpha, mount_from_scenario, os_alpha
-from tdm.frontend.radar_plots import _fill_runs, _label_cells, _spokes_per_label, fill_gaps, label_plots
+from tdm.frontend.radar_plots import _label_cells, _spokes_per_label, fill_gaps, label_plots
 
 __all__ = ["RadarFrontEndConfig", "beam_integrated_power", "ca_alpha", "cfar_mask", "clutter_map", "fill_gaps",
            "label_plots", "mount_from_scenario", "os_alpha", "radar_detections", "training_table", "video_power",
@@ -120,19 +121,50 @@ def _plot_cells(echo: np.ndarray, range_m: np.ndarray, config: RadarFrontEndConf
     first = _first_valid_sample(range_m, config.blanking_m)
     training_table(n_samples, first, config.training_cells, config.guard_cells)  # validates the size
     power_table = video_power_table(config.video_threshold_db, config.video_step_db)
-    nz = np.flatnonzero(echo)
-    levels = echo.ravel()[nz]
-    keep = (nz % n_samples) >= first
-    nz, levels = nz[keep], np.minimum(levels[keep], VIDEO_LEVELS - 1)
-    integrated, g = _integrate_cells(nz, power_table[levels] - 1.0, echo.shape, config)
+    nz = _nonzero_flat(echo)
     rows, cols = np.divmod(nz, n_samples)
+    if first > 0:
+        keep = cols >= first
+        nz, rows, cols = nz[keep], rows[keep], cols[keep]
+    levels = np.minimum(echo.reshape(-1)[nz], VIDEO_LEVELS - 1)
+    integrated, g = _integrate_cells(rows, cols, power_table[levels] - 1.0, echo.shape, config)
     testable = levels >= _lowest_candidate_level(config)
-    detected = np.zeros(nz.size, dtype=bool)
-    detected[testable] = _cfar_cells(echo, rows[testable], cols[testable], config, first)
+    if testable.all():
+        detected = _cfar_cells(echo, rows, cols, config, first)
+    else:
+        detected = np.zeros(nz.size, dtype=bool)
+        detected[testable] = _cfar_cells(echo, rows[testable], cols[testable], config, first)
     if config.fill_level > 0:
-        strong = np.flatnonzero(levels >= config.fill_level)
-        detected[strong[_fill_runs(nz[strong], n_samples, detected[strong])]] = True
+        strong = levels >= config.fill_level
+        if strong.all():
+            detected |= _filled_between_detections(nz, detected, n_samples)
+        else:
+            strong = np.flatnonzero(strong)
+            detected[strong] |= _filled_between_detections(nz[strong], detected[strong], n_samples)
     return nz[detected], integrated, g
+
+
+def _filled_between_detections(flat: np.ndarray, detected: np.ndarray, n_samples: int) -> np.ndarray:
+    """(M,) bool: the cells strictly between two detections of one run (module docstring, step 3).
+
+    ``flat`` (M,) are the ascending flat indices of the cells strong enough to fill, ``detected``
+    (M,) bool which of them are detections; a run is a maximal sequence of them that are
+    consecutive samples of one spoke. Two detections next to each other among the detections
+    share a run exactly when every flat index between them is a strong cell (their flat indices lie
+    as far apart as their positions) on their spoke, and then the cells between them are filled:
+    the same cells as from the first to the last detection of each run
+    (:func:`tdm.frontend.radar_plots.fill_gaps`).
+    """
+    out = np.zeros(flat.size + 1, dtype=np.int8)
+    det = np.flatnonzero(detected)
+    if det.size < 2:
+        return out[:-1].astype(bool)
+    at, nxt = det[:-1], det[1:]
+    f_at, f_nxt = flat[at], flat[nxt]
+    joined = (nxt - at > 1) & (f_nxt - f_at == nxt - at) & (f_at // n_samples == f_nxt // n_samples)
+    out[at[joined] + 1] = 1  # each gap opens after one detection and closes at the next: no overlaps
+    out[nxt[joined]] = -1
+    return np.cumsum(out[:-1], dtype=np.int8).astype(bool)
 
 
 def _checked_sweep(sweep: dict, config: RadarFrontEndConfig

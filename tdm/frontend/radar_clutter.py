@@ -24,16 +24,20 @@ def _group_spokes(n_spokes: int, wanted: int) -> int:
     return 1
 
 
-def _integrate_cells(flat: np.ndarray, excess: np.ndarray, shape: tuple[int, int],
+def _integrate_cells(rows: np.ndarray, cols: np.ndarray, excess: np.ndarray, shape: tuple[int, int],
                      config: RadarFrontEndConfig) -> tuple[np.ndarray, int]:
-    """:func:`beam_integrated_power` from the cells above the floor only (``excess`` = power - 1)."""
+    """:func:`beam_integrated_power` from the cells above the floor only: (M,) spokes ``rows``,
+    samples ``cols`` and ``excess`` = power - 1 (units of the mean noise) of the cells of a sweep of ``shape``."""
     n_spokes, n_samples = shape
     g = _group_spokes(n_spokes, max(1, config.integration_spokes // 2))
-    rows, cols = np.divmod(flat, n_samples)
     groups = np.bincount((rows // g) * n_samples + cols, weights=excess,
                          minlength=(n_spokes // g) * n_samples).reshape(n_spokes // g, n_samples)
-    integrated = (groups + np.roll(groups, -1, axis=0)) * (0.5 / g) + 1.0
-    return integrated.astype(np.float32), g
+    window = np.empty_like(groups)  # group i plus group i + 1 (circular)
+    np.add(groups[:-1], groups[1:], out=window[:-1])
+    np.add(groups[-1], groups[0], out=window[-1])
+    window *= 0.5 / g
+    window += 1.0
+    return window.astype(np.float32), g
 
 
 def beam_integrated_power(power: np.ndarray, config: RadarFrontEndConfig) -> tuple[np.ndarray, int]:
@@ -59,8 +63,8 @@ def beam_integrated_power(power: np.ndarray, config: RadarFrontEndConfig) -> tup
         Spokes per group.
     """
     power = np.asarray(power, dtype=np.float64)
-    flat = np.flatnonzero(power != 1.0)
-    return _integrate_cells(flat, power.ravel()[flat] - 1.0, power.shape, config)
+    rows, cols = np.nonzero(power != 1.0)
+    return _integrate_cells(rows, cols, power[rows, cols] - 1.0, power.shape, config)
 
 
 @lru_cache(maxsize=8)

@@ -16,9 +16,10 @@ import yaml
 from scipy import ndimage
 
 from tdm.frames import EnuFrame, Mount, OwnshipTrack
-from tdm.frontend.radar import (RadarFrontEndConfig, beam_integrated_power, ca_alpha, cfar_mask, clutter_map, fill_gaps,
-                                label_plots, mount_from_scenario, os_alpha, radar_detections, training_table,
-                                video_power)
+from tdm.frontend import radar_cfar, radar_plots
+from tdm.frontend.radar import (RadarFrontEndConfig, _filled_between_detections, beam_integrated_power, ca_alpha,
+                                cfar_mask, clutter_map, fill_gaps, label_plots, mount_from_scenario, os_alpha,
+                                radar_detections, training_table, video_power)
 from tdm.io import read_ownship, read_truth
 from tests.conftest import BASE
 from tests.tdm.conftest import render_recording
@@ -109,6 +110,64 @@ def test_gap_filling_joins_detections_along_a_run_of_echo_only():
     filled = fill_gaps(mask, echo, 1)
     assert filled[0].nonzero()[0].tolist() == [2, 3, 4, 5, 6]
     assert filled[1].nonzero()[0].tolist() == [2, 8]
+
+
+# ------------------------------------------------------------------ fast paths against straightforward references
+
+
+def random_video(rng: np.random.Generator, shape: tuple[int, int], p_zero: float) -> np.ndarray:
+    """(S, N) uint8 video levels: 0 with probability ``p_zero``, else uniform over 1..15."""
+    levels = rng.integers(1, 16, size=shape, dtype=np.uint8)
+    return np.where(rng.random(shape) < p_zero, 0, levels).astype(np.uint8)
+
+
+def test_byte_parallel_os_counts_equal_the_counts_of_the_gathered_training_cells():
+    rng = np.random.default_rng(11)
+    for trial in range(60):
+        n_training, guard = int(rng.choice([2, 4, 10, 16, 22, 32, 48, 66])), int(rng.integers(0, 7))
+        n_samples = int(rng.integers(n_training + 2 * guard + 3, 180))
+        config = RadarFrontEndConfig(training_cells=n_training, guard_cells=guard,
+                                     os_rank=int(rng.integers(1, n_training + 1)))
+        echo = random_video(rng, (int(rng.integers(1, 7)), n_samples), float(rng.choice([0.3, 0.9])))
+        if trial % 3 == 1:
+            echo = echo[:, 1:]  # not C-contiguous, nor a whole number of words: the copied words
+        first = int(rng.integers(0, 3))
+        rows, cols = np.nonzero(np.ones(echo.shape, dtype=bool))
+        rows, cols = rows[cols >= first], cols[cols >= first]
+        train = radar_cfar._training_values(echo, rows, cols, config, first)
+        blocking = radar_cfar._os_blocking_level(config.alpha, config.video_threshold_db, config.video_step_db)
+        expected = np.count_nonzero(train >= blocking[echo[rows, cols]][:, None], axis=1) < n_training - config.rank + 1
+        assert np.array_equal(radar_cfar._cfar_cells(echo, rows, cols, config, first), expected), trial
+
+
+def test_nonzero_cells_through_words_equal_flatnonzero():
+    rng = np.random.default_rng(12)
+    for shape, p_zero in (((64, 128), 0.99), ((64, 128), 0.3), ((7, 13), 0.9), ((1, 1), 0.0), ((3, 8), 1.0)):
+        echo = random_video(rng, shape, p_zero)
+        for levels in (echo, echo[:, 1:], echo[::2]):
+            assert np.array_equal(radar_cfar._nonzero_flat(levels), np.flatnonzero(levels))
+
+
+def test_gap_filling_between_neighbouring_detections_equals_filling_each_run():
+    rng = np.random.default_rng(13)
+    for trial in range(40):
+        n_samples = int(rng.integers(1, 40))
+        strong = rng.random((int(rng.integers(1, 9)), n_samples)) < rng.choice([0.3, 0.8, 1.0])
+        flat = np.flatnonzero(strong)
+        detected = rng.random(flat.size) < rng.choice([0.05, 0.3, 0.7])
+        expected = detected | radar_plots._fill_runs(flat, n_samples, detected)
+        assert np.array_equal(detected | _filled_between_detections(flat, detected, n_samples), expected), trial
+
+
+def test_beam_integration_of_the_cells_above_the_floor_equals_the_sum_over_spokes():
+    rng = np.random.default_rng(14)
+    config = RadarFrontEndConfig()
+    for n_spokes in (2048, 96, 8, 1):
+        power = video_power(random_video(rng, (n_spokes, 64), 0.9), config).astype(np.float64)
+        integrated, g = beam_integrated_power(power, config)
+        groups = power.reshape(n_spokes // g, g, 64).sum(axis=1) - g  # group sums of the excess over the floor
+        expected = ((groups + np.roll(groups, -1, axis=0)) * (0.5 / g) + 1.0).astype(np.float32)
+        assert np.array_equal(integrated, expected)
 
 
 # ------------------------------------------------------------------ labels, plots of synthetic sweeps
