@@ -32,6 +32,7 @@
 from __future__ import annotations
 
 import itertools
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -63,6 +64,9 @@ STILL_SPEED_FRACTION = 0.5
 #: ``max_distance_m``: looser than joining, so that a track does not flicker in and out.
 RELEASE_GATES = 4
 RELEASE_DISTANCES = 2
+#: Relative rounding allowed for a closed-form 2 x 2 eigenvalue and a distance (far above their few ulp): a footprint
+#: test closer to its edge than this is decided by the reference computation.
+_EIGEN_TOLERANCE = 1e-12
 #: The order in which the free tracks of each sensor look for a target: AIS (the identity) first.
 SENSOR_ORDER = ("ais", "lidar", "radar")
 
@@ -210,6 +214,13 @@ def canonical_states(xs: np.ndarray, ps: np.ndarray) -> tuple[np.ndarray, np.nda
     return xs, ps
 
 
+def _inside_reference(state, centre: np.ndarray, half_length_m: float) -> bool:
+    """:meth:`Fuser._inside` in numpy operations (LAPACK's eigenvalue): the reference of its fast decision."""
+    x, p = state
+    sigma = np.sqrt(max(np.linalg.eigvalsh(p[:2, :2])[-1], 0.0))
+    return bool(np.hypot(*(x[:2] - centre[:2])) <= half_length_m + FOOTPRINT_SIGMAS * sigma)
+
+
 class Fuser:
     """Keeps fused targets over time and produces their fused estimates."""
 
@@ -222,6 +233,7 @@ class Fuser:
         self._gate = chi2_gate(config.gate_probability, POSITION_DOF)
         self._moving_since: dict[int, float] = {}
         self._still_since: dict[int, float] = {}
+        self._memo: dict | None = None  # the fused estimates of one step (_estimate)
 
     def step(self, t_s: float, tracks_by_sensor: dict[str, list[Track]],
              own_position_m: np.ndarray | None = None) -> list[FusedEstimate]:
@@ -230,6 +242,15 @@ class Fuser:
         ``own_position_m`` (2,), the own ship's east and north at ``t_s`` (m), lets still targets' radar tracks
         be put behind their painted face (``radar_hidden_depth_fraction``); None: as they are.
         """
+        self._memo = {}
+        try:
+            return self._step(t_s, tracks_by_sensor, own_position_m)
+        finally:
+            self._memo = None
+
+    def _step(self, t_s: float, tracks_by_sensor: dict[str, list[Track]],
+              own_position_m: np.ndarray | None) -> list[FusedEstimate]:
+        """:meth:`step`, with the fused estimates of the step kept (:meth:`_estimate`)."""
         cfg = self.config
         live = {(s, tr.track_id): tr for s, trs in tracks_by_sensor.items() for tr in trs}
         states = {key: tr.predicted(t_s) for key, tr in live.items()}
@@ -331,9 +352,21 @@ class Fuser:
                 states[key] = (x, p)
 
     def _estimate(self, target: FusedTarget, states) -> tuple[np.ndarray, np.ndarray]:
+        """The target's fused state (6,) and covariance (6, 6) from its members' ``states``.
+
+        Within a :meth:`step` (``states`` fixed once the members are checked) a target with the same members
+        is fused once: the arrays are shared, not to be changed in place.
+        """
+        memo = self._memo
+        key = (id(states), tuple(target.members.items()))
+        if memo is not None and key in memo:
+            return memo[key]
         xs = np.array([states[(s, i)][0] for s, i in target.members.items()])
         ps = np.array([states[(s, i)][1] for s, i in target.members.items()])
-        return fuse(xs, ps, self.config.rule)
+        out = fuse(xs, ps, self.config.rule)
+        if memo is not None:
+            memo[key] = out
+        return out
 
     def _half_length(self, target: FusedTarget, live) -> float:
         """Absorbing radius of the target, metres, from its length (AIS static data, else its tracks' extents)."""
@@ -344,9 +377,27 @@ class Fuser:
 
     @staticmethod
     def _inside(state, centre: np.ndarray, half_length_m: float) -> bool:
+        """Whether the track's position lies within ``half_length_m`` plus FOOTPRINT_SIGMAS standard deviations (along
+        its covariance's major axis) of ``centre``.
+
+        Decided on Python floats with the 2 x 2 eigenvalue in closed form when the distance clears the radius by
+        more than their rounding can move either (a generous bound); else as :func:`_inside_reference`, so that
+        every decision is the reference's (tests/tdm/test_fusion.py).
+        """
         x, p = state
-        sigma = np.sqrt(max(np.linalg.eigvalsh(p[:2, :2])[-1], 0.0))
-        return bool(np.hypot(*(x[:2] - centre[:2])) <= half_length_m + FOOTPRINT_SIGMAS * sigma)
+        a, b, d = float(p[0, 0]), float(p[1, 0]), float(p[1, 1])
+        distance = math.hypot(float(x[0]) - float(centre[0]), float(x[1]) - float(centre[1]))
+        largest = 0.5 * (a + d) + math.hypot(0.5 * (a - d), b)
+        if math.isfinite(largest + distance + half_length_m):
+            radius = half_length_m + FOOTPRINT_SIGMAS * math.sqrt(max(largest, 0.0))
+            # sqrt moves by at most sqrt of what the eigenvalue moves; both eigenvalues are within a few ulp of |P|
+            slack = FOOTPRINT_SIGMAS * math.sqrt(_EIGEN_TOLERANCE * (abs(a) + abs(b) + abs(d))) \
+                + _EIGEN_TOLERANCE * (distance + radius)
+            if distance < radius - slack:
+                return True
+            if distance > radius + slack:
+                return False
+        return _inside_reference(state, centre, half_length_m)
 
     def _revive(self, state, t_s: float) -> FusedTarget | None:
         """The recently ended target whose footprint (its last state predicted to ``t_s``) holds ``state``."""

@@ -217,3 +217,26 @@ def test_a_ship_crossing_inside_an_ais_ships_footprint_keeps_its_target(speed_si
         assert len(out) == 2
         (silent,) = [e for e in out if e.target.mmsi is None]
         assert silent.target.target_id == crosser_id and silent.sources == ["radar"]
+
+
+def test_footprint_test_decides_as_the_reference_also_at_its_edge():
+    """Fuser._inside's closed-form decision is the reference's (LAPACK eigenvalue, np.hypot) for random tracks and
+    for tracks placed on the footprint's edge to the last bits, where only the reference can tell."""
+    from tdm.fusion import FOOTPRINT_SIGMAS, _inside_reference
+
+    rng = np.random.default_rng(3)
+    n_edge = 0
+    for k in range(4000):
+        m = rng.normal(size=(2, 2)) * rng.choice([0.01, 1.0, 30.0])
+        p = np.eye(6)
+        p[:2, :2] = m @ m.T + (0.0 if k % 3 else 1e-3) * np.eye(2)
+        centre = rng.normal(0, 300, 6)
+        half = float(rng.uniform(10, 60))
+        radius = half + FOOTPRINT_SIGMAS * np.sqrt(max(np.linalg.eigvalsh(p[:2, :2])[-1], 0.0))
+        bearing = rng.uniform(0, 2 * np.pi)
+        scale = radius * (1.0 + rng.choice([-1, 1]) * rng.choice([0.0, 1e-16, 1e-14, 1e-9, 0.1, 1.0]))
+        x = centre.copy()
+        x[:2] += scale * np.array([np.cos(bearing), np.sin(bearing)])
+        n_edge += abs(scale - radius) < 1e-9 * radius
+        assert Fuser._inside((x, p), centre, half) == _inside_reference((x, p), centre, half)
+    assert n_edge > 1000
