@@ -37,7 +37,7 @@ from tdm.errors import RecordingError
 from tdm.fusion import Fuser, FusionConfig
 from tdm.io import read_manifest, read_scenario
 from tdm.land import LandMask
-from tdm.messages import jsonl_writer, target_record
+from tdm.messages import jsonl_writer, target_records
 from tdm.recording.scenario import MAX_UPDATE_RATE_HZ
 from tdm.run_config import FUSION_RULES, LIDAR_SOURCES, TdmConfig
 from tdm.scans import DetectionStream, start_time_unix_s
@@ -117,22 +117,28 @@ class _Tracking:
         by_sensor = {s: tr.confirmed_tracks() for s, tr in self.trackers.items()}
         by_sensor["ais"] = self.ais.confirmed_tracks()
         own = self.ownship.position_m(np.array([t_out]))[0, :2]
+        targets = []
         for estimate in self.fuser.step(t_out, by_sensor, own):
             tgt = estimate.target
             if self.on_land(estimate.x):
                 continue
-            write_target(target_record(t_out, tgt.target_id, tgt.descriptor, estimate.x, estimate.p,
-                                       estimate.sources, frame, tgt.mmsi))
+            targets.append((tgt.target_id, tgt.descriptor, estimate.x, estimate.p, estimate.sources, tgt.mmsi, None))
             self.target_ids.add(tgt.target_id)
             self.n_lines += 1
         descriptors = {(s, i): t.descriptor for t in self.fuser.targets for s, i in t.members.items()}
-        for sensor, tracks in by_sensor.items():
-            for tr in tracks:
+        tracks = []
+        for sensor, trs in by_sensor.items():
+            for tr in trs:
                 x, p = tr.reported(t_out)
                 if self.on_land(x):
                     continue
-                write_track(target_record(t_out, tr.track_id, descriptors.get((sensor, tr.track_id), "unknown"),
-                                          x, p, [sensor], frame, tr.mmsi, sensor=sensor))
+                tracks.append((tr.track_id, descriptors.get((sensor, tr.track_id), "unknown"), x, p, [sensor], tr.mmsi,
+                               sensor))
+        records = target_records(t_out, targets + tracks, frame)  # one lat/lon conversion for the epoch
+        for record in records[:len(targets)]:
+            write_target(record)
+        for record in records[len(targets):]:
+            write_track(record)
 
 
 def _checked_config(rec: Path, config: TdmConfig | None) -> TdmConfig:

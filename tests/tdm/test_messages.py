@@ -7,7 +7,7 @@ import pytest
 
 from tdm import ekf
 from tdm.frames import EnuFrame
-from tdm.messages import jsonl_writer, target_record
+from tdm.messages import jsonl_writer, target_record, target_records
 
 FRAME = EnuFrame(59.43, 10.47)
 
@@ -64,3 +64,23 @@ def test_jsonl_writer_leaves_nothing_when_interrupted(tmp_path):
             write({"t": 0.0})
             raise RuntimeError("stop")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_records_of_an_epoch_are_those_of_one_state_at_a_time():
+    """target_records (one lat/lon conversion for all states) gives the very records of target_record, one by one,
+    and the writer the lines of json.dumps."""
+    import json
+
+    rng = np.random.default_rng(4)
+    rows = []
+    for k in range(300):
+        x, p = state(e=float(rng.normal(0, 3000)), n=float(rng.normal(0, 3000)), psi=float(rng.uniform(-4, 4)),
+                     u=float(rng.normal(0, 5)), alpha=float(rng.uniform(0, 900)))
+        rows.append((k, "vessel", x, p, ["ais", "radar"], None if k % 2 else 257000000 + k, None if k % 3 else "radar"))
+    records = target_records(123.4, rows, FRAME)
+    singles = [target_record(123.4, *row[:5], FRAME, row[5], row[6]) for row in rows]
+    dumps = [json.dumps(r, separators=(", ", ": ")) for r in singles]
+    assert [json.dumps(r, separators=(", ", ": ")) for r in records] == dumps
+    from tdm.messages import _ENCODER
+    assert [_ENCODER.encode(r) for r in records] == dumps
+    assert target_records(0.0, [], FRAME) == []
