@@ -30,6 +30,9 @@ N_STATES = 6
 E, N, PSI, U, R, ALPHA = range(N_STATES)
 _EYE = np.eye(N_STATES)
 _TWO_PI = 2 * np.pi
+#: Entries (row, column) of the process noise that can be non-zero, in the order process_covariance forms them.
+_Q_ROWS, _Q_COLS = np.array([(E, E), (N, N), (E, N), (E, PSI), (N, PSI), (E, U), (N, U), (E, R), (N, R), (PSI, R),
+                             (PSI, PSI), (U, U), (R, R), (ALPHA, ALPHA)]).T
 
 
 @dataclass(frozen=True)
@@ -136,41 +139,35 @@ def process_covariance(x: np.ndarray, dt_s: float, q: ProcessNoise) -> np.ndarra
     aq_ep, aq_eu, aq_np, aq_nu = a_ep * q_psi, a_eu * q_u, a_np * q_psi, a_nu * q_u  # A Qc
     a2q_er, a2q_nr = a_ep * q_r, a_np * q_r  # A^2 Qc
     # 2 A Qc A^T: its east/north block sums two products (fused multiply-adds in BLAS: kept a matrix product)
-    two_aq = np.zeros((2, N_STATES))
-    two_aq[0, PSI], two_aq[0, U], two_aq[1, PSI], two_aq[1, U] = 2.0 * aq_ep, 2.0 * aq_eu, 2.0 * aq_np, 2.0 * aq_nu
-    a_en = np.zeros((2, N_STATES))
-    a_en[0, PSI], a_en[0, U], a_en[1, PSI], a_en[1, U] = a_ep, a_eu, a_np, a_nu
-    (m_ee, m_en), (m_ne, m_nn) = _block_product(two_aq, a_en).tolist()
-    out = {  # (row, column): the five terms of the polynomial, summed in the matrix form's order
-        (E, E): q_pos * dt + m_ee * dt3 / 6.0 + a2q_er * a_ep * dt5 / 20.0,
-        (N, N): q_pos * dt + m_nn * dt3 / 6.0 + a2q_nr * a_np * dt5 / 20.0,
-        (E, N): 0.0 + m_en * dt3 / 6.0 + a2q_er * a_np * dt5 / 20.0,
-        (N, E): 0.0 + m_ne * dt3 / 6.0 + a2q_nr * a_ep * dt5 / 20.0,
-        (E, PSI): 0.0 + aq_ep * dt2 / 2.0 + a2q_er * dt4 / 8.0,
-        (N, PSI): 0.0 + aq_np * dt2 / 2.0 + a2q_nr * dt4 / 8.0,
-        (E, U): 0.0 + aq_eu * dt2 / 2.0,
-        (N, U): 0.0 + aq_nu * dt2 / 2.0,
-        (E, R): 0.0 + a2q_er * dt3 / 6.0,
-        (N, R): 0.0 + a2q_nr * dt3 / 6.0,
-        (PSI, R): 0.0 + q_r * dt2 / 2.0,
-        (PSI, PSI): q_psi * dt + 2.0 * q_r * dt3 / 6.0,
-        (U, U): q_u * dt, (R, R): q_r * dt, (ALPHA, ALPHA): q_alpha * dt,
-    }
-    rows = [[0.0] * N_STATES for _ in range(N_STATES)]
-    for (i, j), value in out.items():  # 0.5 (out + out^T): every listed entry but (E, N) is symmetric as is
-        rows[i][j] = rows[j][i] = 0.5 * (value + out.get((j, i), value))
-    return np.array(rows)
+    (m_ee, m_en), (m_ne, m_nn) = _two_term_block(2.0 * aq_ep, 2.0 * aq_eu, 2.0 * aq_np, 2.0 * aq_nu,
+                                                 a_ep, a_eu, a_np, a_nu)
+    en = 0.5 * ((0.0 + m_en * dt3 / 6.0 + a2q_er * a_np * dt5 / 20.0) + (0.0 + m_ne * dt3 / 6.0 + a2q_nr * a_ep * dt5 / 20.0))
+    # the terms of the polynomial, summed in the matrix form's order; 0.5 (out + out^T) leaves these as they are
+    # (symmetric bit for bit), but for east/north
+    values = [q_pos * dt + m_ee * dt3 / 6.0 + a2q_er * a_ep * dt5 / 20.0,  # (E, E)
+              q_pos * dt + m_nn * dt3 / 6.0 + a2q_nr * a_np * dt5 / 20.0,  # (N, N)
+              en,  # (E, N)
+              0.0 + aq_ep * dt2 / 2.0 + a2q_er * dt4 / 8.0, 0.0 + aq_np * dt2 / 2.0 + a2q_nr * dt4 / 8.0,  # (E|N, PSI)
+              0.0 + aq_eu * dt2 / 2.0, 0.0 + aq_nu * dt2 / 2.0,  # (E|N, U)
+              0.0 + a2q_er * dt3 / 6.0, 0.0 + a2q_nr * dt3 / 6.0,  # (E|N, R)
+              0.0 + q_r * dt2 / 2.0,  # (PSI, R)
+              q_psi * dt + 2.0 * q_r * dt3 / 6.0, q_u * dt, q_r * dt, q_alpha * dt]  # diagonal
+    out = np.zeros((N_STATES, N_STATES))
+    out[_Q_ROWS, _Q_COLS] = values
+    out[_Q_COLS, _Q_ROWS] = values
+    return out
 
 
-def _block_product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``a @ b.T`` of two (2, 6) matrices as rows of (6, 6) ones: the BLAS product of the matrix form.
-
-    Padded to (6, 6), so that BLAS runs the same kernel, with the same order of fused multiply-adds, as
-    in :func:`_process_covariance_array`.
-    """
-    full_a, full_b = np.zeros((N_STATES, N_STATES)), np.zeros((N_STATES, N_STATES))
-    full_a[:2], full_b[:2] = a, b
-    return (full_a @ full_b.T)[:2, :2]
+def _two_term_block(b_ep: float, b_eu: float, b_np: float, b_nu: float,
+                    a_ep: float, a_eu: float, a_np: float, a_nu: float) -> list[list[float]]:
+    """East/north block (2, 2) of ``B @ A.T`` for (6, 6) matrices whose east and north rows hold only
+    the given course (``_ep``, ``_np``) and speed (``_eu``, ``_nu``) entries: BLAS's product of the
+    matrix form, with the same padding, so that BLAS runs the same kernel, with the same order of fused
+    multiply-adds, as in :func:`_process_covariance_array`."""
+    b, a = np.zeros((N_STATES, N_STATES)), np.zeros((N_STATES, N_STATES))
+    b[E, PSI], b[E, U], b[N, PSI], b[N, U] = b_ep, b_eu, b_np, b_nu
+    a[E, PSI], a[E, U], a[N, PSI], a[N, U] = a_ep, a_eu, a_np, a_nu
+    return (b @ a.T)[:2, :2].tolist()
 
 
 def _process_covariance_array(x: np.ndarray, dt_s: float, q: ProcessNoise) -> np.ndarray:
@@ -254,7 +251,7 @@ def update(x: np.ndarray, p: np.ndarray, z: np.ndarray, h: np.ndarray, r: np.nda
     k = p @ h.T @ s_inv
     x_new = x + k @ y
     x_new[PSI] = wrap_pi(x_new[PSI])
-    i_kh = np.eye(N_STATES) - k @ h
+    i_kh = _EYE - k @ h
     p_new = i_kh @ p @ i_kh.T + k @ r @ k.T
     return x_new, 0.5 * (p_new + p_new.T), float(y @ s_inv @ y)
 

@@ -355,13 +355,15 @@ class PositionTracker:
         # one object seen twice: keep the older confirmed track
         confirmed = sorted((t for t in keep if t.confirmed), key=lambda t: t.created_s)
         dropped: set[int] = set()
+        velocity = {t.track_id: ekf.velocity_en(t.x) for t in confirmed}  # each track's, once
         for a, b in itertools.combinations(confirmed, 2):
             if a.track_id in dropped or b.track_id in dropped:
                 continue
+            if not np.hypot(*(velocity[a.track_id] - velocity[b.track_id])) < cfg.merge_speed_mps:
+                continue  # not moving alike
             xb = ekf.predict_mean(b.x, a.t_s - b.t_s)
             near = max(cfg.merge_distance_m, 0.5 * (a.length_m + b.length_m))
-            moving_alike = np.hypot(*(ekf.velocity_en(a.x) - ekf.velocity_en(b.x))) < cfg.merge_speed_mps
-            if np.hypot(*(a.x[:2] - xb[:2])) < near and moving_alike:
+            if np.hypot(*(a.x[:2] - xb[:2])) < near:
                 dropped.add(b.track_id)
         self.tracks = [t for t in keep if t.track_id not in dropped]
 
