@@ -31,7 +31,8 @@ Steps (numpy/scipy-vectorised; Python loops only over chunks of cells):
    Only cells that can pass at all are tested (level >= ``min_echo_level`` and power above
    ``alpha x`` the floor): a few per cent of a sweep. For OS on video the counts of a CUT whose
    training cells all lie on its spoke are byte-parallel on the sweep's aligned 64-bit words (eight
-   4-bit levels compared at once, the training bytes masked, one ``np.bitwise_count``); otherwise
+   4-bit levels compared at once, the training bytes masked, one ``np.bitwise_count``), or, for a
+   blocking level many CUTs share, on the bit plane of the cells that reach it; otherwise
    the training cells are read through ``numpy.lib.stride_tricks.sliding_window_view`` (two
    contiguous halves per CUT) or, near the ends, a precomputed index table.
 
@@ -75,7 +76,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import ndimage
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import connected_components
 
 from tdm.detections import Detections
 from tdm.frames import Mount, OwnshipTrack
@@ -83,7 +85,7 @@ from tdm.frontend.radar_cfar import (VIDEO_LEVELS, _cfar_cells, _first_valid_sam
                                      cfar_mask, training_table, video_power, video_power_table)
 from tdm.frontend.radar_clutter import _integrate_cells, _margin_over_clutter_db, beam_integrated_power, clutter_map
 from tdm.frontend.radar_config import RadarFrontEndConfig, ca_alpha, mount_from_scenario, os_alpha
-from tdm.frontend.radar_plots import _label_cells, _spokes_per_label, fill_gaps, label_plots
+from tdm.frontend.radar_plots import _runs, _spokes_per_label, fill_gaps, label_plots
 
 __all__ = ["RadarFrontEndConfig", "beam_integrated_power", "ca_alpha", "cfar_mask", "clutter_map", "fill_gaps",
            "label_plots", "mount_from_scenario", "os_alpha", "radar_detections", "training_table", "video_power",
@@ -205,26 +207,89 @@ class _Plots:
 
 
 def _kept_plots(echo: np.ndarray, range_m: np.ndarray, config: RadarFrontEndConfig) -> _Plots | None:
-    """The plots that pass the size, spoke and clutter tests (module docstring, steps 1-6), or None."""
+    """The plots that pass the size, spoke and clutter tests (module docstring, steps 1-6), or None.
+
+    Counts and tests run on the plots' runs along range (:func:`_label_runs`); only the cells of the
+    plots that pass the size and spoke tests are spelt out for the clutter test.
+    """
     n_spokes, n_samples = echo.shape
     flat, integrated, g = _plot_cells(echo, range_m, config)
     if flat.size == 0:
         return None
-    spoke, sample = np.divmod(flat, n_samples)
-    lab, n = _label_cells(flat, n_spokes, n_samples)
-    n_cells = np.bincount(lab, minlength=n + 1)
-    n_spk = _spokes_per_label(lab, spoke, n + 1, n_spokes)
-    keep = (n_cells >= config.min_plot_cells) & (n_cells <= config.max_plot_cells) & (n_spk >= config.min_plot_spokes)
+    runs = _label_runs(flat, n_spokes, n_samples)
+    n_cells = np.bincount(runs.label, weights=runs.length, minlength=runs.n + 1)
+    keep = (n_cells >= config.min_plot_cells) & (n_cells <= config.max_plot_cells)
     keep[0] = False
-    margin_db = _margin_over_clutter_db(lab, spoke, sample, n + 1, keep, integrated, g, config)
+    sized = np.flatnonzero(keep[runs.label])
+    keep &= _spokes_per_label(runs.label[sized], runs.spoke[sized], runs.n + 1, n_spokes) >= config.min_plot_spokes
+    pos, lab, spoke = _run_cells(runs, np.flatnonzero(keep[runs.label]))
+    sample = flat[pos] - spoke * n_samples
+    margin_db = _margin_over_clutter_db(lab, spoke, sample, runs.n + 1, keep, integrated, g, config)
     keep &= margin_db >= config.clutter_margin_db
     if not keep.any():
         return None
     margin_db = margin_db[np.flatnonzero(keep)].astype(np.float64)
     sel = keep[lab]
-    spoke, sample, lab = spoke[sel], sample[sel], lab[sel]
-    _, lab = np.unique(lab, return_inverse=True)  # 0..m-1
-    return _Plots(spoke, sample, lab, int(lab.max()) + 1, margin_db)
+    number = np.cumsum(keep) - 1  # kept labels -> 0..m-1 in their order
+    return _Plots(spoke[sel], sample[sel], number[lab[sel]], int(number[-1]) + 1, margin_db)
+
+
+@dataclass(frozen=True)
+class _Runs:
+    """A sweep's plot cells as runs along range (ascending flat order): (R,) position in the cells'
+    ``flat`` of each run's first cell, its length, spoke and plot label 1..n; n the number of plots."""
+
+    start: np.ndarray
+    length: np.ndarray
+    spoke: np.ndarray
+    label: np.ndarray
+    n: int
+
+
+def _label_runs(flat: np.ndarray, n_spokes: int, n_samples: int) -> _Runs:
+    """Runs of the cells ``flat`` (ascending flat indices, not empty) labelled by 8-connectivity,
+    circular in azimuth: the partition and numbering of :func:`tdm.frontend.radar_plots._label_cells`.
+
+    Two runs on neighbouring spokes (the last spoke's neighbour is the first) touch when their sample
+    intervals, widened by one, overlap; the runs' graph, built as CSR (each run's row its touching
+    runs on the previous spoke), goes through ``scipy.sparse.csgraph.connected_components``, which
+    numbers components in the order of their first node (checked; renumbered if not).
+    """
+    starts, ends = _runs(flat, n_samples)
+    spoke, a = np.divmod(flat[starts], n_samples)
+    b = flat[ends] - spoke * n_samples
+    width = n_samples + 2  # keys keep spokes apart: spoke * width + sample, samples -1 .. n_samples
+    prev = (spoke - 1) % n_spokes
+    lo = np.searchsorted(spoke * width + b, prev * width + a - 1, side="left")  # first on prev ending >= a - 1
+    hi = np.searchsorted(spoke * width + a, prev * width + b + 1, side="right")  # past the last starting <= b + 1
+    count = np.maximum(hi - lo, 0)
+    if n_spokes < 3:  # a spoke is its own neighbour's neighbour: no self-loops
+        count = np.where(prev == spoke, 0, count)
+    indptr = np.zeros(starts.size + 1, dtype=np.int64)
+    np.cumsum(count, out=indptr[1:])
+    neighbours = np.repeat(lo - indptr[:-1], count) + np.arange(indptr[-1])
+    graph = csr_matrix((np.ones(neighbours.size), neighbours, indptr), shape=(starts.size, starts.size))
+    n, comp = connected_components(graph, directed=False)
+    return _Runs(starts, ends - starts + 1, spoke, (_numbered_by_first(comp) + 1).astype(np.int32), int(n))
+
+
+def _numbered_by_first(comp: np.ndarray) -> np.ndarray:
+    """(R,) int component numbers 0..n-1 of ``comp`` (R,), renumbered in the order of their first element.
+
+    ``connected_components`` numbers them so already (checked in one pass); else renumbered by sorting.
+    """
+    if comp.size == 0 or (comp[0] == 0 and not np.any(np.diff(np.maximum.accumulate(comp)) > 1)):
+        return comp
+    _, first, inverse = np.unique(comp, return_index=True, return_inverse=True)
+    return np.argsort(np.argsort(first))[inverse]
+
+
+def _run_cells(runs: _Runs, which: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The cells of the runs ``which`` (ascending): (M,) position in the cells' ``flat``, label and spoke of each."""
+    length = runs.length[which]
+    offset = np.cumsum(length) - length  # each run's first cell among the M
+    pos = np.repeat(runs.start[which] - offset, length) + np.arange(int(offset[-1] + length[-1]) if length.size else 0)
+    return pos, np.repeat(runs.label[which], length), np.repeat(runs.spoke[which], length)
 
 
 def _centroids(plots: _Plots, power: np.ndarray, range_m: np.ndarray, azimuth_deg: np.ndarray
@@ -244,18 +309,34 @@ def _extents(plots: _Plots, power: np.ndarray, azimuth_deg: np.ndarray, bearing_
              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(m,) range extent Lr (m), cross-range extent Lc (m) and beam fill of each plot, less the smear of
     the range point-spread and of the beam (:func:`radar_detections`)."""
-    lab, index = plots.label, np.arange(plots.n)
+    lab = plots.label
     d_az = _wrap_deg(azimuth_deg[plots.spoke] - bearing_rel_deg[lab])
     spoke_deg = 360.0 / n_spokes
-    extent_az_deg = ndimage.maximum(d_az, lab, index) - ndimage.minimum(d_az, lab, index) + spoke_deg
-    extent_r_m = (ndimage.maximum(plots.sample, lab, index) - ndimage.minimum(plots.sample, lab, index) + 1) * spacing_m
+    az_max, az_min = _label_max_min(d_az, lab, plots.n)
+    extent_az_deg = az_max - az_min + spoke_deg
+    sample_max, sample_min = _label_max_min(plots.sample, lab, plots.n)
+    extent_r_m = (sample_max - sample_min + 1) * spacing_m
     # log2 of the plot's power ratio, strongest to weakest cell
-    dynamic_log2 = np.log2(np.maximum(ndimage.maximum(power, lab, index) / ndimage.minimum(power, lab, index), 1.0))
+    power_max, power_min = _label_max_min(power, lab, plots.n)
+    dynamic_log2 = np.log2(np.maximum(power_max / power_min, 1.0))
     len_r_m = np.maximum(extent_r_m - config.range_resolution_m * np.sqrt(dynamic_log2), spacing_m)
     beam_smear_deg = config.beam_az_deg * np.sqrt(dynamic_log2 / TWO_WAY)
     len_c_m = np.maximum(plot_range_m, spacing_m) * np.radians(np.maximum(extent_az_deg - beam_smear_deg, spoke_deg))
     beam_fill = extent_az_deg / np.maximum(beam_smear_deg, spoke_deg)
     return len_r_m, len_c_m, beam_fill
+
+
+def _label_max_min(values: np.ndarray, lab: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """(n,) largest and (n,) smallest of ``values`` (M,) per label 0..n-1 of ``lab`` (M,), in the values' dtype
+    (``scipy.ndimage.maximum`` / ``minimum``; every label holds a cell)."""
+    if np.issubdtype(values.dtype, np.floating):
+        low, high = np.inf, -np.inf
+    else:
+        low, high = np.iinfo(values.dtype).max, np.iinfo(values.dtype).min
+    largest, smallest = np.full(n, high, dtype=values.dtype), np.full(n, low, dtype=values.dtype)
+    np.maximum.at(largest, lab, values)
+    np.minimum.at(smallest, lab, values)
+    return largest, smallest
 
 
 def _plot_positions(bearing_rel_deg: np.ndarray, plot_range_m: np.ndarray, azimuth_deg: np.ndarray,

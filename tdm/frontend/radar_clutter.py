@@ -129,13 +129,20 @@ def _block_max_db(integrated: np.ndarray, group_spokes: int, config: RadarFrontE
 
 
 def _clutter_level_db(block_db: np.ndarray, bi: np.ndarray, bj: np.ndarray, config: RadarFrontEndConfig) -> np.ndarray:
-    """(K,) float32 clutter level (dB) of blocks (bi, bj): the quantile of their annulus's block maxima."""
+    """(K,) float32 clutter level (dB) of blocks (bi, bj): the quantile of their annulus's block maxima.
+
+    The annulus is read from the block maxima padded by half a window: circular in azimuth, -inf
+    beyond the ends of the range scale (one gather of K x annulus values).
+    """
     sb, nb = block_db.shape
+    half_a, half_r = config.clutter_window_blocks[0] // 2, config.clutter_window_blocks[1] // 2
     da, dr = _annulus_offsets(tuple(config.clutter_window_blocks), tuple(config.clutter_guard_blocks))
-    rj = bj[:, None] + dr[None, :]
-    inside = (rj >= 0) & (rj < nb)
-    values = np.where(inside, block_db[(bi[:, None] + da[None, :]) % sb, np.clip(rj, 0, nb - 1)], -np.inf)
-    n_valid = inside.sum(axis=1)
+    width = nb + 2 * half_r
+    padded = np.full((sb + 2 * half_a, width), -np.inf, dtype=block_db.dtype)
+    padded[:, half_r:half_r + nb] = block_db[np.arange(-half_a, sb + half_a) % sb]
+    values = padded.reshape(-1)[(bi * width + bj)[:, None] + ((da + half_a) * width + dr + half_r)[None, :]]
+    n_valid = _annulus_columns_in_range(nb, tuple(config.clutter_window_blocks),
+                                        tuple(config.clutter_guard_blocks))[bj]
     # the q-quantile of each block's valid values: rank ceil(q n) among them (-inf sort first)
     rank = values.shape[1] - n_valid + np.maximum(np.ceil(config.clutter_quantile * n_valid).astype(np.int64), 1) - 1
     q_db = np.empty(bi.size, dtype=np.float32)
@@ -149,6 +156,13 @@ def _clutter_level_db(block_db: np.ndarray, bi: np.ndarray, bj: np.ndarray, conf
     return q_db
 
 
+@lru_cache(maxsize=8)
+def _annulus_columns_in_range(nb: int, window: tuple[int, int], guard: tuple[int, int]) -> np.ndarray:
+    """(nb,) int64: how many of the annulus's blocks lie inside the range scale, per block column."""
+    _, dr = _annulus_offsets(window, guard)
+    col = np.arange(nb)[:, None] + dr[None, :]
+    return np.count_nonzero((col >= 0) & (col < nb), axis=1).astype(np.int64)
+
 
 def _margin_over_clutter_db(lab: np.ndarray, spoke: np.ndarray, sample: np.ndarray, n_labels: int,
                             eligible: np.ndarray, integrated: np.ndarray, g: int,
@@ -161,16 +175,21 @@ def _margin_over_clutter_db(lab: np.ndarray, spoke: np.ndarray, sample: np.ndarr
     (:func:`clutter_map` gives the same threshold for every block).
     """
     margin_db = np.full(n_labels, -np.inf, dtype=np.float32)
-    a = integrated.shape[0]
-    k = spoke // g
-    before, here = integrated[(k - 1) % a, sample], integrated[k, sample]
+    a, n_samples = integrated.shape
+    cells = np.flatnonzero(eligible[lab])
+    k = spoke[cells] // g
+    here_at = k * n_samples + sample[cells]
+    before_at = here_at - n_samples  # window k - 1, circular
+    before_at[k == 0] += a * n_samples
+    before, here = integrated.reshape(-1)[before_at], integrated.reshape(-1)[here_at]
     value = np.maximum(before, here)
     # only cells above the lowest seed threshold can be a kept plot's peak
-    cells = np.flatnonzero((value >= np.float32(10.0 ** (config.min_seed_db / 10.0))) & eligible[lab])
-    if cells.size == 0:
+    seed = np.flatnonzero(value >= np.float32(10.0 ** (config.min_seed_db / 10.0)))
+    if seed.size == 0:
         return margin_db
-    value, lab_c = value[cells], lab[cells]
-    row = np.where(before[cells] > here[cells], (k[cells] - 1) % a, k[cells])
+    cells, value, k = cells[seed], value[seed], k[seed]
+    lab_c = lab[cells]
+    row = np.where(before[seed] > here[seed], (k - 1) % a, k)
     peak = np.full(n_labels, -np.inf, dtype=np.float32)
     np.maximum.at(peak, lab_c, value)
     at_peak = np.flatnonzero(value == peak[lab_c])

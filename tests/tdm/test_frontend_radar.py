@@ -16,8 +16,9 @@ import yaml
 from scipy import ndimage
 
 from tdm.frames import EnuFrame, Mount, OwnshipTrack
-from tdm.frontend import radar_cfar, radar_plots
-from tdm.frontend.radar import (RadarFrontEndConfig, _filled_between_detections, beam_integrated_power, ca_alpha,
+from tdm.frontend import radar_cfar, radar_clutter, radar_plots
+from tdm.frontend.radar import (RadarFrontEndConfig, _filled_between_detections, _label_max_min, _label_runs,
+                                _numbered_by_first, _run_cells, beam_integrated_power, ca_alpha,
                                 cfar_mask, clutter_map, fill_gaps, label_plots, mount_from_scenario, os_alpha,
                                 radar_detections, training_table, video_power)
 from tdm.io import read_ownship, read_truth
@@ -121,7 +122,9 @@ def random_video(rng: np.random.Generator, shape: tuple[int, int], p_zero: float
     return np.where(rng.random(shape) < p_zero, 0, levels).astype(np.uint8)
 
 
-def test_byte_parallel_os_counts_equal_the_counts_of_the_gathered_training_cells():
+@pytest.mark.parametrize("bit_plane_fraction", [0.0, 0.05, math.inf])  # every level / common levels / none on planes
+def test_byte_parallel_os_counts_equal_the_counts_of_the_gathered_training_cells(bit_plane_fraction, monkeypatch):
+    monkeypatch.setattr(radar_cfar, "_BIT_PLANE_MIN_FRACTION", bit_plane_fraction)
     rng = np.random.default_rng(11)
     for trial in range(60):
         n_training, guard = int(rng.choice([2, 4, 10, 16, 22, 32, 48, 66])), int(rng.integers(0, 7))
@@ -168,6 +171,49 @@ def test_beam_integration_of_the_cells_above_the_floor_equals_the_sum_over_spoke
         groups = power.reshape(n_spokes // g, g, 64).sum(axis=1) - g  # group sums of the excess over the floor
         expected = ((groups + np.roll(groups, -1, axis=0)) * (0.5 / g) + 1.0).astype(np.float32)
         assert np.array_equal(integrated, expected)
+
+
+def reference_clutter_level_db(block_db: np.ndarray, bi: int, bj: int, config: RadarFrontEndConfig) -> float:
+    """The clutter_quantile of the block maxima of one block's annulus (circular in azimuth, cut in range)."""
+    (wa, wr), (ga, gr) = config.clutter_window_blocks, config.clutter_guard_blocks
+    values = [block_db[(bi + da) % block_db.shape[0], bj + dr]
+              for da in range(-(wa // 2), wa // 2 + 1) for dr in range(-(wr // 2), wr // 2 + 1)
+              if not (abs(da) <= ga // 2 and abs(dr) <= gr // 2) and 0 <= bj + dr < block_db.shape[1]]
+    return float(np.sort(values)[max(math.ceil(config.clutter_quantile * len(values)), 1) - 1])
+
+
+def test_clutter_level_from_the_padded_block_maxima_equals_the_annulus_quantile():
+    rng = np.random.default_rng(15)
+    for window, guard, shape in (((65, 5), (5, 3), (16, 128)), ((5, 7), (1, 3), (3, 4)), ((3, 1), (1, 1), (40, 2))):
+        config = RadarFrontEndConfig(clutter_window_blocks=window, clutter_guard_blocks=guard, clutter_quantile=0.9)
+        block_db = rng.normal(10.0, 5.0, shape).astype(np.float32)
+        bi, bj = (a.ravel() for a in np.indices(shape))
+        expected = [reference_clutter_level_db(block_db, i, j, config) for i, j in zip(bi, bj)]
+        assert np.array_equal(radar_clutter._clutter_level_db(block_db, bi, bj, config), np.float32(expected))
+
+
+def test_runs_labels_and_per_label_extremes_equal_the_cell_labels_and_ndimage():
+    rng = np.random.default_rng(16)
+    for trial in range(30):
+        shape = (int(rng.integers(1, 12)), int(rng.integers(1, 20)))
+        flat = np.flatnonzero(rng.random(shape) < rng.choice([0.2, 0.5, 0.9]))
+        if flat.size == 0:
+            continue
+        runs = _label_runs(flat, *shape)
+        pos, lab, spoke = _run_cells(runs, np.arange(runs.start.size))
+        expected, n = radar_plots._label_cells(flat, *shape)
+        assert np.array_equal(pos, np.arange(flat.size)) and np.array_equal(spoke, flat // shape[1])
+        assert np.array_equal(lab, expected) and runs.n == n, trial
+        for values in (rng.normal(size=flat.size), flat % shape[1]):
+            largest, smallest = _label_max_min(values, lab - 1, n)
+            assert np.array_equal(largest, ndimage.maximum(values, lab - 1, np.arange(n)))
+            assert np.array_equal(smallest, ndimage.minimum(values, lab - 1, np.arange(n)))
+
+
+def test_components_numbered_by_their_first_run_whatever_order_they_come_in():
+    comp = np.array([2, 2, 0, 1, 0, 2])
+    assert _numbered_by_first(comp).tolist() == [0, 0, 1, 2, 1, 0]
+    assert _numbered_by_first(np.array([0, 1, 0, 2, 1])).tolist() == [0, 1, 0, 2, 1]
 
 
 # ------------------------------------------------------------------ labels, plots of synthetic sweeps
