@@ -63,6 +63,8 @@ class ProcessNoise:
 
 def wrap_pi(angle_rad):
     """Angle(s) wrapped into [-pi, pi)."""
+    if isinstance(angle_rad, float) and math.isfinite(angle_rad):  # one angle: Python's float modulo is np.mod's
+        return np.float64((angle_rad + math.pi) % _TWO_PI - math.pi)
     return np.mod(np.asarray(angle_rad) + np.pi, 2 * np.pi) - np.pi
 
 

@@ -236,11 +236,11 @@ class PositionTracker:
         tracks = self.tracks
         pairs: list[tuple[int, int]] = []
         if tracks and n_det:
-            states = np.stack([t.x for t in tracks])
+            states = np.array([t.x for t in tracks])
             # mean predicted to each detection's own time; covariance at the scan's mean time
             dt = dets.time_s[None, :] - np.array([t.t_s for t in tracks])[:, None]
             pred = ekf.predict_mean(states[:, None, :], dt)
-            p_pos = np.stack([t.predicted(t_scan)[1][:2, :2] for t in tracks])
+            p_pos = np.array([t.predicted(t_scan)[1][:2, :2] for t in tracks])
             s = p_pos[:, None] + cov[None, :]
             cost = mahalanobis2(pos[None, :, :] - pred[..., :2], s)
             pairs = gnn(cost, self._gate)

@@ -155,3 +155,11 @@ def test_non_finite_states_take_the_matrix_forms():
     np.testing.assert_array_equal(ekf.process_covariance(x, 2.0, q), ekf._process_covariance_array(x, 2.0, q))
     np.testing.assert_array_equal(ekf.transition(x, 2.0)[1], ekf._transition_array(x, 2.0)[1])
     assert np.isnan(ekf.predict_mean(x, 2.0)[ekf.PSI])
+
+
+def test_one_angle_wraps_as_the_array_form():
+    angles = np.concatenate([np.random.default_rng(6).normal(0, 30, 20000), [np.pi, -np.pi, 0.0, -0.0, 3 * np.pi]])
+    for a in angles:
+        assert ekf.wrap_pi(float(a)).tobytes() == ekf.wrap_pi(np.array([a]))[0].tobytes()
+        assert ekf.wrap_pi(a).tobytes() == ekf.wrap_pi(np.array([a]))[0].tobytes()
+    assert np.isnan(ekf.wrap_pi(float("nan")))
