@@ -221,6 +221,40 @@ def _inside_reference(state, centre: np.ndarray, half_length_m: float) -> bool:
     return bool(np.hypot(*(x[:2] - centre[:2])) <= half_length_m + FOOTPRINT_SIGMAS * sigma)
 
 
+def _clearly_apart(estimates: list[tuple[np.ndarray, np.ndarray]], half_lengths_m: list[float]) -> np.ndarray:
+    """Which pairs of targets :meth:`Fuser._inside` certainly finds apart, all at once.
+
+    Parameters
+    ----------
+    estimates : list of T tuples of (6,) and (6, 6) float
+        The targets' fused states and covariances, oldest first.
+    half_lengths_m : list of T float
+        Their absorbing radii, m.
+
+    Returns
+    -------
+    (T, T) bool
+        ``[i, j]`` (i < j): target j lies outside the footprint of target i with radius ``max(half_i, half_j)``,
+        clear of the edge by more than the rounding bound of :meth:`Fuser._inside` (no pair it would find inside;
+        the pairs near the edge and the lower triangle are False: left to :meth:`Fuser._inside`).
+    """
+    n = len(estimates)
+    if n < 2:
+        return np.zeros((n, n), dtype=bool)
+    xy = np.array([x[:2] for x, _ in estimates])
+    cov = np.array([p[:2, :2] for _, p in estimates])
+    a, b, d = cov[:, 0, 0], cov[:, 1, 0], cov[:, 1, 1]
+    largest = 0.5 * (a + d) + np.hypot(0.5 * (a - d), b)
+    half = np.asarray(half_lengths_m, dtype=float)
+    radius = np.maximum(half[:, None], half[None, :]) + FOOTPRINT_SIGMAS * np.sqrt(np.maximum(largest, 0.0))[None, :]
+    distance = np.hypot(xy[None, :, 0] - xy[:, None, 0], xy[None, :, 1] - xy[:, None, 1])
+    slack = FOOTPRINT_SIGMAS * np.sqrt(_EIGEN_TOLERANCE * (np.abs(a) + np.abs(b) + np.abs(d)))[None, :] \
+        + _EIGEN_TOLERANCE * (distance + radius)
+    with np.errstate(invalid="ignore"):
+        out = distance > radius + 2.0 * slack  # NaN: False
+    return np.triu(out, 1)
+
+
 class Fuser:
     """Keeps fused targets over time and produces their fused estimates."""
 
@@ -369,11 +403,21 @@ class Fuser:
         return out
 
     def _half_length(self, target: FusedTarget, live) -> float:
-        """Absorbing radius of the target, metres, from its length (AIS static data, else its tracks' extents)."""
+        """Absorbing radius of the target, metres, from its length (AIS static data, else its tracks' extents).
+
+        Within a :meth:`step` (``live`` fixed) formed once for the same members and MMSI.
+        """
+        memo = self._memo
+        key = ("half", target.mmsi, tuple(target.members.items()))
+        if memo is not None and key in memo:
+            return memo[key]
         lengths = [live[(s, i)].length_m for s, i in target.members.items()]
         if target.mmsi is not None:
             lengths.append(self.lengths_by_mmsi.get(target.mmsi, 0.0))
-        return max(self.config.min_extent_m, self.config.absorb_lengths * max([v for v in lengths if np.isfinite(v)] or [0.0]))
+        out = max(self.config.min_extent_m, self.config.absorb_lengths * max([v for v in lengths if np.isfinite(v)] or [0.0]))
+        if memo is not None:
+            memo[key] = out
+        return out
 
     @staticmethod
     def _inside(state, centre: np.ndarray, half_length_m: float) -> bool:
@@ -428,12 +472,15 @@ class Fuser:
         targets = sorted(self.targets, key=lambda t: (t.created_s, t.target_id))
         est = {t.target_id: self._estimate(t, states) for t in targets}
         half = {t.target_id: self._half_length(t, live) for t in targets}
+        apart = _clearly_apart([est[t.target_id] for t in targets], [half[t.target_id] for t in targets])
         gone: set[int] = set()
         for i, older in enumerate(targets):
             if older.target_id in gone:
                 continue
-            for younger in targets[i + 1:]:
-                if younger.target_id in gone:
+            grown = False  # older has taken a target in: its estimate is no longer the one ``apart`` saw
+            for j in range(i + 1, len(targets)):
+                younger = targets[j]
+                if younger.target_id in gone or (apart[i, j] and not grown):
                     continue
                 xo, _ = est[older.target_id]
                 xy, py = est[younger.target_id]
@@ -456,6 +503,7 @@ class Fuser:
                 if older.descriptor == "unknown":
                     older.descriptor = younger.descriptor
                 gone.add(younger.target_id)
+                grown = True
                 est[older.target_id] = self._estimate(older, states)
                 half[older.target_id] = self._half_length(older, live)
         self.targets = [t for t in self.targets if t.target_id not in gone]

@@ -240,3 +240,34 @@ def test_footprint_test_decides_as_the_reference_also_at_its_edge():
         n_edge += abs(scale - radius) < 1e-9 * radius
         assert Fuser._inside((x, p), centre, half) == _inside_reference((x, p), centre, half)
     assert n_edge > 1000
+
+
+def test_targets_found_clearly_apart_all_at_once_are_apart_one_by_one():
+    """_clearly_apart (the merge's vectorised first look) is True only where the reference footprint test says
+    outside, also for targets placed on each other's footprint edge, and leaves few outside pairs to it."""
+    from tdm.fusion import FOOTPRINT_SIGMAS, _clearly_apart, _inside_reference
+
+    rng = np.random.default_rng(8)
+    n_apart = n_outside = 0
+    for _ in range(60):
+        n = int(rng.integers(2, 25))
+        estimates, halves = [], [float(h) for h in rng.uniform(10, 60, n)]
+        for k in range(n):
+            m = rng.normal(size=(2, 2)) * rng.choice([0.01, 1.0, 20.0])
+            p = np.eye(6)
+            p[:2, :2] = m @ m.T
+            x = rng.normal(0, 150, 6)
+            if k and k % 2:  # on the edge of the previous target's footprint
+                radius = max(halves[k - 1], halves[k]) + FOOTPRINT_SIGMAS * np.sqrt(np.linalg.eigvalsh(p[:2, :2])[-1])
+                bearing = rng.uniform(0, 2 * np.pi)
+                x[:2] = estimates[k - 1][0][:2] + radius * (1 + rng.choice([-1e-15, 0.0, 1e-15, 1e-12])) * \
+                    np.array([np.cos(bearing), np.sin(bearing)])
+            estimates.append((x, p))
+        apart = _clearly_apart(estimates, halves)
+        for i in range(n):
+            for j in range(n):
+                outside = i < j and not _inside_reference(estimates[j], estimates[i][0], max(halves[i], halves[j]))
+                assert not apart[i, j] or outside
+                n_apart += bool(apart[i, j])
+                n_outside += outside
+    assert n_apart > 0.9 * n_outside
