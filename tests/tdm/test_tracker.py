@@ -172,3 +172,19 @@ def test_a_track_reports_the_uncertainty_of_the_centre_behind_the_side_it_sees()
     assert a.length_m == pytest.approx(20.0)
     np.testing.assert_allclose(p_b[:2, :2] - p_a[:2, :2], (0.25 * 20.0) ** 2 * np.eye(2))
     np.testing.assert_array_equal(p_b[2:, 2:], p_a[2:, 2:])
+
+
+def test_a_kept_prediction_is_the_fresh_one_and_is_dropped_when_the_track_changes():
+    tracker = PositionTracker("lidar", TrackerConfig(max_range_m=1e4))
+    for k in range(4):
+        tracker.process(scan(k * 0.5, [[10.0 + 2.0 * k, 5.0]]), np.zeros(2))
+    track = tracker.tracks[0]
+    first = track.predicted(3.0)
+    assert track.predicted(3.0) is first  # kept
+    fresh = ekf.predict(track.x, track.p, 3.0 - track.t_s, track.process)
+    assert first[0].tobytes() == fresh[0].tobytes() and first[1].tobytes() == fresh[1].tobytes()
+    tracker.process(scan(2.0, [[18.0, 5.0]]), np.zeros(2))  # updated: a new state
+    after = track.predicted(3.0)
+    assert after is not first and not np.array_equal(after[1], first[1])
+    fresh = ekf.predict(track.x, track.p, 3.0 - track.t_s, track.process)
+    assert after[1].tobytes() == fresh[1].tobytes()
