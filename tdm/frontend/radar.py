@@ -83,7 +83,8 @@ from tdm.detections import Detections
 from tdm.frames import Mount, OwnshipTrack
 from tdm.frontend.radar_cfar import (VIDEO_LEVELS, _cfar_cells, _first_valid_sample, _lowest_candidate_level, _nonzero_flat,
                                      cfar_mask, training_table, video_power, video_power_table)
-from tdm.frontend.radar_clutter import _integrate_cells, _margin_over_clutter_db, beam_integrated_power, clutter_map
+from tdm.frontend.radar_clutter import (_group_sums, _margin_over_clutter_db, _windows, beam_integrated_power, clutter_map,
+                                       integration_group)
 from tdm.frontend.radar_config import RadarFrontEndConfig, ca_alpha, mount_from_scenario, os_alpha
 from tdm.frontend.radar_plots import _runs, _spokes_per_label, fill_gaps, label_plots
 
@@ -98,6 +99,8 @@ UNIFORM_VARIANCE_DIVISOR = 12.0
 TWO_WAY = 2.0
 #: Smallest norm of a horizontal beam direction before it is normalised (no division by zero).
 _MIN_DIRECTION_NORM = 1e-12
+#: Cells per block of spokes the detection steps work on at a time (their per-cell arrays stay in cache).
+_BLOCK_CELLS = 1 << 18
 #: Sample spacing taken for a sweep of one sample, m (no spacing to measure).
 _ONE_SAMPLE_SPACING_M = 1.0
 
@@ -122,20 +125,39 @@ def _plot_cells(echo: np.ndarray, range_m: np.ndarray, config: RadarFrontEndConf
     n_spokes, n_samples = echo.shape
     first = _first_valid_sample(range_m, config.blanking_m)
     training_table(n_samples, first, config.training_cells, config.guard_cells)  # validates the size
+    g = integration_group(n_spokes, config)
+    step = g * max(1, _BLOCK_CELLS // (g * n_samples))  # spokes per block, whole integration groups
+    groups = np.empty((n_spokes // g, n_samples))
+    cells = []
+    for r0 in range(0, n_spokes, step):
+        block = echo[r0:r0 + step]
+        flat, groups[r0 // g:(r0 + block.shape[0]) // g] = _block_cells(block, first, g, config)
+        cells.append(flat + r0 * n_samples)
+    return np.concatenate(cells), _windows(groups, g), g
+
+
+def _block_cells(block: np.ndarray, first: int, g: int, config: RadarFrontEndConfig) -> tuple[np.ndarray, np.ndarray]:
+    """Detected and filled cells of a block of whole integration groups of spokes (S_b, N) of a sweep,
+    and its :func:`~tdm.frontend.radar_clutter._group_sums` (S_b / g, N) (module docstring, steps 1-3, 5).
+
+    Works on the cells above level 0 only (a few per cent of a sweep). Returns (M,) int64 ascending
+    flat indices within the block.
+    """
+    n_samples = block.shape[1]
     power_table = video_power_table(config.video_threshold_db, config.video_step_db)
-    nz = _nonzero_flat(echo)
+    nz = _nonzero_flat(block)
     rows, cols = np.divmod(nz, n_samples)
     if first > 0:
         keep = cols >= first
         nz, rows, cols = nz[keep], rows[keep], cols[keep]
-    levels = np.minimum(echo.reshape(-1)[nz], VIDEO_LEVELS - 1)
-    integrated, g = _integrate_cells(rows, cols, power_table[levels] - 1.0, echo.shape, config)
+    levels = np.minimum(block.reshape(-1)[nz], VIDEO_LEVELS - 1)
+    groups = _group_sums(rows, cols, power_table[levels] - 1.0, block.shape[0] // g, g, n_samples)
     testable = levels >= _lowest_candidate_level(config)
     if testable.all():
-        detected = _cfar_cells(echo, rows, cols, config, first)
+        detected = _cfar_cells(block, rows, cols, config, first)
     else:
         detected = np.zeros(nz.size, dtype=bool)
-        detected[testable] = _cfar_cells(echo, rows[testable], cols[testable], config, first)
+        detected[testable] = _cfar_cells(block, rows[testable], cols[testable], config, first)
     if config.fill_level > 0:
         strong = levels >= config.fill_level
         if strong.all():
@@ -143,7 +165,7 @@ def _plot_cells(echo: np.ndarray, range_m: np.ndarray, config: RadarFrontEndConf
         else:
             strong = np.flatnonzero(strong)
             detected[strong] |= _filled_between_detections(nz[strong], detected[strong], n_samples)
-    return nz[detected], integrated, g
+    return nz[detected], groups
 
 
 def _filled_between_detections(flat: np.ndarray, detected: np.ndarray, n_samples: int) -> np.ndarray:

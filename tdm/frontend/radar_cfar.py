@@ -135,7 +135,7 @@ _BITS_PER_WORD = 64
 #: A blocking level's CUTs are counted on its bit plane when they number at least this fraction of the
 #: sweep's cells (a plane reads every cell once; on 2048 x 1024 sweeps packing one took 0.1-0.2 ms and
 #: counting 77 000 CUTs on it 0.6 ms, on the bytes about 3.5 ms).
-_BIT_PLANE_MIN_FRACTION = 1.0 / 1024
+_BIT_PLANE_MIN_FRACTION = 1.0 / 128
 #: Cells per chunk of the byte-parallel count (bounded temporaries that stay in cache: chunk x 8 bytes each).
 _WORD_CHUNK_CELLS = 1 << 15
 

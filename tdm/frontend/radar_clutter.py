@@ -12,6 +12,8 @@ from tdm.frontend.radar_config import RadarFrontEndConfig
 
 __all__ = ["beam_integrated_power", "clutter_map"]
 
+#: Cells per part of the integration windows' float64 temporaries (they stay in cache).
+_WINDOW_PART_CELLS = 1 << 15
 #: Block maxima are floored here (linear power over the mean noise) before they go to dB: no log of 0.
 BLOCK_POWER_FLOOR = 1e-6
 
@@ -24,20 +26,40 @@ def _group_spokes(n_spokes: int, wanted: int) -> int:
     return 1
 
 
+def _group_sums(rows: np.ndarray, cols: np.ndarray, excess: np.ndarray, n_groups: int, g: int,
+                n_samples: int) -> np.ndarray:
+    """(n_groups, n_samples) float64 sums of ``excess`` (M,) = power - 1 (units of the mean noise) of the
+    cells (``rows``, ``cols``) (M,) over groups of ``g`` spokes, added in the cells' order."""
+    return np.bincount((rows // g) * n_samples + cols, weights=excess,
+                       minlength=n_groups * n_samples).reshape(n_groups, n_samples)
+
+
+def _windows(groups: np.ndarray, g: int) -> np.ndarray:
+    """(A, N) float32 integrated power, units of the mean noise: row i the mean of groups i and i + 1
+    (circular) of ``g`` spokes' excess each (:func:`_group_sums`, (A, N)), plus the floor."""
+    window = np.empty(groups.shape, dtype=np.float32)
+    rows_per_part = max(1, _WINDOW_PART_CELLS // max(1, groups.shape[1]))
+    for lo in range(0, groups.shape[0], rows_per_part):  # parts: small temporaries
+        hi = min(lo + rows_per_part, groups.shape[0])
+        part = groups[lo:hi] + np.concatenate([groups[lo + 1:hi + 1], groups[:max(0, hi + 1 - groups.shape[0])]])
+        part *= 0.5 / g
+        np.add(part, 1.0, out=window[lo:hi])  # in float64, then rounded to float32 once
+    return window
+
+
 def _integrate_cells(rows: np.ndarray, cols: np.ndarray, excess: np.ndarray, shape: tuple[int, int],
                      config: RadarFrontEndConfig) -> tuple[np.ndarray, int]:
     """:func:`beam_integrated_power` from the cells above the floor only: (M,) spokes ``rows``,
     samples ``cols`` and ``excess`` = power - 1 (units of the mean noise) of the cells of a sweep of ``shape``."""
     n_spokes, n_samples = shape
-    g = _group_spokes(n_spokes, max(1, config.integration_spokes // 2))
-    groups = np.bincount((rows // g) * n_samples + cols, weights=excess,
-                         minlength=(n_spokes // g) * n_samples).reshape(n_spokes // g, n_samples)
-    window = np.empty_like(groups)  # group i plus group i + 1 (circular)
-    np.add(groups[:-1], groups[1:], out=window[:-1])
-    np.add(groups[-1], groups[0], out=window[-1])
-    window *= 0.5 / g
-    window += 1.0
-    return window.astype(np.float32), g
+    g = integration_group(n_spokes, config)
+    return _windows(_group_sums(rows, cols, excess, n_spokes // g, g, n_samples), g), g
+
+
+def integration_group(n_spokes: int, config: RadarFrontEndConfig) -> int:
+    """Spokes per group of the beam integration (:func:`beam_integrated_power`): ``integration_spokes / 2``,
+    or the largest divisor of ``n_spokes`` under it."""
+    return _group_spokes(n_spokes, max(1, config.integration_spokes // 2))
 
 
 def beam_integrated_power(power: np.ndarray, config: RadarFrontEndConfig) -> tuple[np.ndarray, int]:
@@ -123,8 +145,10 @@ def _block_max_db(integrated: np.ndarray, group_spokes: int, config: RadarFrontE
     if (sb * ba, nb * bn) != (a, n):
         padded = np.ones((sb * ba, nb * bn), dtype=np.float32)
         padded[:a, :n] = integrated
-    block_max = np.maximum.reduce(padded.reshape(sb, ba, nb * bn), axis=1)
-    block_max = np.maximum.reduce(block_max.reshape(sb, nb, bn), axis=2)
+    rows_max = np.maximum.reduce(padded.reshape(sb, ba, nb * bn), axis=1).reshape(sb, nb, bn)
+    block_max = rows_max[:, :, 0].copy()
+    for j in range(1, bn):  # across the bn samples of a block: bn - 1 element-wise maxima (no short inner axis)
+        np.maximum(block_max, rows_max[:, :, j], out=block_max)
     return 10.0 * np.log10(np.maximum(block_max, np.float32(BLOCK_POWER_FLOOR))), ba
 
 

@@ -16,7 +16,7 @@ import yaml
 from scipy import ndimage
 
 from tdm.frames import EnuFrame, Mount, OwnshipTrack
-from tdm.frontend import radar_cfar, radar_clutter, radar_plots
+from tdm.frontend import radar, radar_cfar, radar_clutter, radar_plots
 from tdm.frontend.radar import (RadarFrontEndConfig, _filled_between_detections, _label_max_min, _label_runs,
                                 _numbered_by_first, _run_cells, beam_integrated_power, ca_alpha,
                                 cfar_mask, clutter_map, fill_gaps, label_plots, mount_from_scenario, os_alpha,
@@ -162,7 +162,8 @@ def test_gap_filling_between_neighbouring_detections_equals_filling_each_run():
         assert np.array_equal(detected | _filled_between_detections(flat, detected, n_samples), expected), trial
 
 
-def test_beam_integration_of_the_cells_above_the_floor_equals_the_sum_over_spokes():
+def test_beam_integration_of_the_cells_above_the_floor_equals_the_sum_over_spokes(monkeypatch):
+    monkeypatch.setattr(radar_clutter, "_WINDOW_PART_CELLS", 3 * 64)  # windows worked out 3 rows at a time
     rng = np.random.default_rng(14)
     config = RadarFrontEndConfig()
     for n_spokes in (2048, 96, 8, 1):
@@ -171,6 +172,24 @@ def test_beam_integration_of_the_cells_above_the_floor_equals_the_sum_over_spoke
         groups = power.reshape(n_spokes // g, g, 64).sum(axis=1) - g  # group sums of the excess over the floor
         expected = ((groups + np.roll(groups, -1, axis=0)) * (0.5 / g) + 1.0).astype(np.float32)
         assert np.array_equal(integrated, expected)
+
+
+@pytest.mark.parametrize("block_cells", [1, 3 * 8 * SAMPLES, 1 << 30])  # 1 integration group, 3, the sweep
+def test_plot_cells_by_blocks_of_spokes_equal_cfar_gap_filling_and_integration_of_the_sweep(block_cells, monkeypatch):
+    monkeypatch.setattr(radar, "_BLOCK_CELLS", block_cells)
+    rng = np.random.default_rng(17)
+    config = RadarFrontEndConfig()
+    for n_spokes in (96, 10):
+        echo = random_video(rng, (n_spokes, SAMPLES), 0.95)
+        echo[:, 600:640] = rng.integers(3, 8, size=(n_spokes, 40))  # extended echoes: runs to fill
+        flat, integrated, g = radar._plot_cells(echo, RANGE_M, config)
+        first = int(np.searchsorted(RANGE_M, config.blanking_m))
+        blanked = echo.copy()
+        blanked[:, :first] = 0
+        expected = fill_gaps(cfar_mask(blanked, config, RANGE_M), blanked, config.fill_level)
+        assert np.array_equal(flat, np.flatnonzero(expected))
+        expected_integrated, expected_g = beam_integrated_power(video_power(blanked, config).astype(np.float64), config)
+        assert g == expected_g and np.array_equal(integrated, expected_integrated)
 
 
 def reference_clutter_level_db(block_db: np.ndarray, bi: int, bj: int, config: RadarFrontEndConfig) -> float:
