@@ -8,11 +8,13 @@
   gives for the member, or beyond :data:`MAX_ARRAY_BYTES`, is refused before anything is allocated.
 * :func:`load_arrays` then reads the asked members into arrays of exactly that checked size.
 
-A file of up to :data:`IN_MEMORY_MAX_BYTES` is read in one system call and its stored (uncompressed)
-members, which is how ``np.savez`` and raysim write them, are taken from those bytes: the member's
-place from its local header, its CRC-32 checked as ``zipfile`` checks it, and its ``.npy`` header read
+A file of up to :data:`IN_MEMORY_MAX_BYTES` is read in one system call. When it is a plain archive of
+stored (uncompressed) members, which is how ``np.savez`` and raysim write sweeps, its directory is read
+from those bytes (:mod:`tdm.recording.zip_stored`) and each member's data sliced out of them, its
+CRC-32 checked as ``zipfile`` checks it; otherwise ``zipfile`` reads the directory (and says what is
+wrong with a damaged one), stored members still coming from the bytes. Each ``.npy`` header is read
 by a fast parser of numpy's own header text (anything else goes to numpy's parser). Compressed
-members and larger files go through ``zipfile``'s streams. Both routes give the same arrays and the
+members and larger files go through ``zipfile``'s streams. Every route gives the same arrays and the
 same errors (tests/tdm/test_recording.py).
 
 A file that cannot be read as such an archive at all (zero bytes, not a zip, cut short, damaged
@@ -38,6 +40,7 @@ import numpy as np
 
 from tdm.errors import RecordingError
 from tdm.recording.files import regular_file
+from tdm.recording.zip_stored import StoredMember, stored_members
 
 __all__ = ["ArrayHeader", "NpzFile", "Unreadable", "read_layout", "load_arrays", "MAX_ARRAY_BYTES",
            "IN_MEMORY_MAX_BYTES"]
@@ -108,8 +111,10 @@ class ArrayHeader:
         return math.prod(self.shape) * self.dtype.itemsize
 
 
-def _open_zip(path: Path) -> tuple[zipfile.ZipFile, bytes | None]:
-    """The archive, and the file's bytes when it is small enough to be read whole (else None)."""
+def _open_zip(path: Path) -> tuple[zipfile.ZipFile | None, bytes | None, list[StoredMember] | None]:
+    """The archive: a :class:`zipfile.ZipFile` (None when the members were found without it), the file's
+    bytes when it is small enough to be read whole (else None), and its stored members when it is a
+    plain archive of them (:func:`tdm.recording.zip_stored.stored_members`; else None)."""
     regular_file(path)
     size = os.stat(path).st_size
     if size == 0:
@@ -119,8 +124,11 @@ def _open_zip(path: Path) -> tuple[zipfile.ZipFile, bytes | None]:
         magic = data[:2] if data is not None else handle.read(2)
     if magic != b"PK":
         raise Unreadable(NOT_A_ZIP)
+    members = stored_members(data) if data is not None else None
+    if members is not None:
+        return None, data, members
     try:
-        return zipfile.ZipFile(io.BytesIO(data) if data is not None else path), data
+        return zipfile.ZipFile(io.BytesIO(data) if data is not None else path), data, None
     except _ZIP_ERRORS:
         raise Unreadable(CUT_SHORT) from None
 
@@ -178,15 +186,26 @@ def _parse_header(fp, info: zipfile.ZipInfo, path: Path) -> ArrayHeader:
     return header
 
 
-def _member_header(zf: zipfile.ZipFile, info: zipfile.ZipInfo, path: Path, data: bytes | None) -> ArrayHeader:
+def _member_header(zf: zipfile.ZipFile | None, info: zipfile.ZipInfo | StoredMember, path: Path,
+                   data: bytes | None) -> ArrayHeader:
     try:
-        stored = _stored_member(data, info, check_crc=False)  # the data is not read: as zipfile, no CRC
-        if stored is not None:
-            return _parse_header(stored, info, path)
-        with zf.open(info) as fp:
+        with _member_stream(zf, info, data, check_crc=False) as fp:  # the data is not read: as zipfile, no CRC
             return _parse_header(fp, info, path)
     except _ZIP_ERRORS:
         raise Unreadable(DAMAGED, f"array {info.filename[:-4]!r}") from None
+
+
+def _member_stream(zf: zipfile.ZipFile | None, info: zipfile.ZipInfo | StoredMember, data: bytes | None,
+                   check_crc: bool = True):
+    """A stream over a member's data: from the bytes in memory when the member is stored (its CRC-32
+    checked unless ``check_crc`` is false), else :meth:`zipfile.ZipFile.open` (which checks it at the end)."""
+    if isinstance(info, StoredMember):
+        member = memoryview(data)[info.data_start:info.data_start + info.file_size]
+        if check_crc and zlib.crc32(member) != info.CRC:
+            raise zipfile.BadZipFile(f"bad CRC-32 for {info.filename}")
+        return _MemberView(member)
+    stored = _stored_member(data, info, check_crc)
+    return stored if stored is not None else zf.open(info)
 
 
 class _MemberView:
@@ -256,10 +275,11 @@ class NpzFile:
 
     def __init__(self, path: Path, preload: tuple[str, ...] = ()):
         self.path = Path(path)
-        self._zf, self._data = _open_zip(self.path)
+        self._zf, self._data, members = _open_zip(self.path)
         self._loaded: dict[str, np.ndarray] = {}
         try:
-            self._infos = {info.filename[:-4]: info for info in self._zf.infolist() if info.filename.endswith(".npy")}
+            infos = members if members is not None else self._zf.infolist()
+            self._infos = {info.filename[:-4]: info for info in infos if info.filename.endswith(".npy")}
             self.layout = {}
             for name, info in self._infos.items():
                 if name in preload:
@@ -267,7 +287,7 @@ class NpzFile:
                 else:
                     self.layout[name] = _member_header(self._zf, info, self.path, self._data)
         except BaseException:
-            self._zf.close()
+            self.close()
             raise
 
     def load(self, names: tuple[str, ...]) -> dict[str, np.ndarray]:
@@ -279,7 +299,8 @@ class NpzFile:
                 else _read_member(self._zf, self._infos[n], self.path, self._data)[1] for n in names}
 
     def close(self) -> None:
-        self._zf.close()
+        if self._zf is not None:
+            self._zf.close()
         self._data = None
 
     def __enter__(self) -> "NpzFile":
@@ -303,11 +324,10 @@ def read_layout(path: Path) -> dict[str, ArrayHeader]:
         return npz.layout
 
 
-def _read_member(zf: zipfile.ZipFile, info: zipfile.ZipInfo, path: Path,
+def _read_member(zf: zipfile.ZipFile | None, info: zipfile.ZipInfo | StoredMember, path: Path,
                  data: bytes | None = None) -> tuple[ArrayHeader, np.ndarray]:
     try:
-        stored = _stored_member(data, info)
-        with stored if stored is not None else zf.open(info) as fp:
+        with _member_stream(zf, info, data) as fp:
             header = _parse_header(fp, info, path)
             flat = np.empty(math.prod(header.shape), dtype=header.dtype)  # size checked against the archive
             view = memoryview(flat.view(np.uint8)) if header.nbytes else memoryview(bytearray(0))

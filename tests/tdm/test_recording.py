@@ -166,3 +166,26 @@ def test_numbers_are_finite_and_bounded():
     assert integer(2048.0, "f", "k", 1, 65536) == 2048
     with pytest.raises(RecordingError, match="whole number"):
         integer(2048.5, "f", "k", 1, 65536)
+
+
+def test_a_plain_stored_archives_directory_is_read_as_zipfile_reads_it(tmp_path):
+    from tdm.recording.zip_stored import stored_members
+
+    np.savez(tmp_path / "a.npz", x=np.arange(10.0), ring=np.arange(4, dtype=np.uint8), empty=np.zeros(0))
+    data = (tmp_path / "a.npz").read_bytes()
+    members = stored_members(data)
+    with zipfile.ZipFile(tmp_path / "a.npz") as zf:
+        infos = zf.infolist()
+        assert [(m.filename, m.file_size, m.CRC) for m in members] == [(i.filename, i.file_size, i.CRC) for i in infos]
+        for member, info in zip(members, infos):
+            assert data[member.data_start:member.data_start + member.file_size] == zf.read(info)
+    # anything else is left to zipfile: compressed, a comment, data in front, a cut directory
+    np.savez_compressed(tmp_path / "c.npz", x=np.arange(10.0))
+    with zipfile.ZipFile(tmp_path / "m.npz", "w") as zf:
+        zf.writestr("x.npy", _npy(np.arange(3)))
+        zf.comment = b"made by hand"
+    assert stored_members((tmp_path / "c.npz").read_bytes()) is None
+    assert stored_members((tmp_path / "m.npz").read_bytes()) is None
+    assert stored_members(b"junk" + data) is None
+    assert stored_members(data[:-30] + data[-22:]) is None
+    assert stored_members(data[:10]) is None
