@@ -55,6 +55,9 @@ SECONDS_PER_MINUTE = 60.0
 #: An AIS course over ground is used only above this speed over ground, m/s (0.6 kn: below it the COG
 #: of a drifting ship is noise).
 AIS_COG_MIN_SOG_MPS = 0.3
+#: Relative distance to a limit within which a decision taken for many pairs at once is taken again pair by pair
+#: (far above the one-ulp differences of a vectorised ``np.hypot``).
+_EDGE_TOLERANCE = 1e-9
 
 
 @dataclass(frozen=True)
@@ -355,17 +358,65 @@ class PositionTracker:
         # one object seen twice: keep the older confirmed track
         confirmed = sorted((t for t in keep if t.confirmed), key=lambda t: t.created_s)
         dropped: set[int] = set()
-        velocity = {t.track_id: ekf.velocity_en(t.x) for t in confirmed}  # each track's, once
-        for a, b in itertools.combinations(confirmed, 2):
-            if a.track_id in dropped or b.track_id in dropped:
-                continue
-            if not np.hypot(*(velocity[a.track_id] - velocity[b.track_id])) < cfg.merge_speed_mps:
-                continue  # not moving alike
-            xb = ekf.predict_mean(b.x, a.t_s - b.t_s)
-            near = max(cfg.merge_distance_m, 0.5 * (a.length_m + b.length_m))
-            if np.hypot(*(a.x[:2] - xb[:2])) < near:
+        for ia, ib in _same_object_pairs(confirmed, cfg):  # in the order of itertools.combinations
+            a, b = confirmed[ia], confirmed[ib]
+            if a.track_id not in dropped and b.track_id not in dropped:
                 dropped.add(b.track_id)
         self.tracks = [t for t in keep if t.track_id not in dropped]
+
+
+def _same_object_pairs(tracks: list[Track], cfg: TrackerConfig) -> list[tuple[int, int]]:
+    """The pairs (i, j), i < j, of tracks that are one object seen twice, in row-major order.
+
+    One object: they move alike (:func:`_moving_alike`) and track j, predicted to track i's time, lies closer to it
+    than ``merge_distance_m`` or half their summed lengths. Decided for all pairs at once (elementwise the same
+    operations as one pair's); a distance within a rounding error of the limit is decided again pair by pair.
+    """
+    ia, ib = np.nonzero(_moving_alike(tracks, cfg.merge_speed_mps))
+    if ia.size == 0:
+        return []
+    x = np.array([t.x for t in tracks])
+    t_s = np.array([t.t_s for t in tracks])
+    length = np.array([t.length_m for t in tracks])
+    xb = ekf.predict_mean(x[ib], t_s[ia] - t_s[ib])
+    half_sum = 0.5 * (length[ia] + length[ib])
+    near = np.where(half_sum > cfg.merge_distance_m, half_sum, cfg.merge_distance_m)  # as max(merge, half_sum)
+    distance = np.hypot(x[ia, 0] - xb[:, 0], x[ia, 1] - xb[:, 1])
+    with np.errstate(invalid="ignore"):
+        close = distance < near
+        edge = np.abs(distance - near) <= _EDGE_TOLERANCE * near
+    for k in np.nonzero(edge)[0]:
+        a, b = tracks[ia[k]], tracks[ib[k]]
+        xb_k = ekf.predict_mean(b.x, a.t_s - b.t_s)
+        close[k] = np.hypot(*(a.x[:2] - xb_k[:2])) < max(cfg.merge_distance_m, 0.5 * (a.length_m + b.length_m))
+    return [(i, j) for i, j, c in zip(ia.tolist(), ib.tolist(), close.tolist()) if c]
+
+
+def _moving_alike(tracks: list[Track], merge_speed_mps: float) -> np.ndarray:
+    """Which pairs of tracks move alike: velocities (:func:`tdm.ekf.velocity_en`) less than ``merge_speed_mps`` apart.
+
+    Parameters
+    ----------
+    tracks : list of C Track
+    merge_speed_mps : float
+
+    Returns
+    -------
+    (C, C) bool
+        ``[i, j]`` for i < j (the lower triangle False). Decided for all pairs at once; a pair within a rounding
+        error of the limit is decided again one by one, as ``np.hypot`` of the pair's difference, so that every
+        decision is that of the pair-by-pair form (tests/tdm/test_tracker.py).
+    """
+    if len(tracks) < 2:
+        return np.zeros((len(tracks), len(tracks)), dtype=bool)
+    v = np.array([ekf.velocity_en(t.x) for t in tracks])
+    speed = np.hypot(v[:, None, 0] - v[None, :, 0], v[:, None, 1] - v[None, :, 1])
+    with np.errstate(invalid="ignore"):
+        alike = speed < merge_speed_mps
+        edge = np.abs(speed - merge_speed_mps) <= _EDGE_TOLERANCE * merge_speed_mps
+    for i, j in zip(*np.nonzero(np.triu(edge, 1))):
+        alike[i, j] = np.hypot(*(v[i] - v[j])) < merge_speed_mps
+    return np.triu(alike, 1)
 
 
 @dataclass(frozen=True)

@@ -1,5 +1,6 @@
 """Per-sensor trackers on synthetic detections with known truth."""
 
+import itertools
 from dataclasses import replace
 
 import numpy as np
@@ -188,3 +189,56 @@ def test_a_kept_prediction_is_the_fresh_one_and_is_dropped_when_the_track_change
     assert after is not first and not np.array_equal(after[1], first[1])
     fresh = ekf.predict(track.x, track.p, 3.0 - track.t_s, track.process)
     assert after[1].tobytes() == fresh[1].tobytes()
+
+
+def _same_object_pairs_one_by_one(tracks, cfg):
+    """The pair-by-pair form of tracker._same_object_pairs (the reference)."""
+    out = []
+    for i, j in itertools.combinations(range(len(tracks)), 2):
+        a, b = tracks[i], tracks[j]
+        xb = ekf.predict_mean(b.x, a.t_s - b.t_s)
+        near = max(cfg.merge_distance_m, 0.5 * (a.length_m + b.length_m))
+        alike = np.hypot(*(ekf.velocity_en(a.x) - ekf.velocity_en(b.x))) < cfg.merge_speed_mps
+        if np.hypot(*(a.x[:2] - xb[:2])) < near and alike:
+            out.append((i, j))
+    return out
+
+
+def test_one_object_pairs_found_all_at_once_are_those_found_pair_by_pair():
+    """Also for tracks placed on the distance and speed limits to the last bits, and with NaN lengths."""
+    from tdm.tracker import Track, _same_object_pairs
+
+    cfg = TrackerConfig()
+    rng = np.random.default_rng(9)
+    n_pairs = n_edge = 0
+    for _ in range(150):
+        n = int(rng.integers(0, 14))
+        tracks = []
+        for k in range(n):
+            x = np.array([*np.round(rng.normal(0, 15, 2) * 1024) / 1024, rng.uniform(-4, 4), rng.normal(0, 2),
+                          rng.normal(0, 0.02), 50.0])
+            t = float(rng.uniform(0, 1))
+            length = float(rng.choice([np.nan, 5.0, 30.0]))
+            if k and rng.uniform() < 0.5:  # on a limit of an earlier track
+                a = tracks[int(rng.integers(0, k))]
+                if rng.uniform() < 0.5:  # velocity merge_speed_mps off the earlier track's
+                    va, angle = ekf.velocity_en(a.x), rng.uniform(0, 2 * np.pi)
+                    v = va + cfg.merge_speed_mps * (1 + rng.choice([-1e-16, 0.0, 1e-16])) * np.array([np.sin(angle), np.cos(angle)])
+                    x[ekf.PSI], x[ekf.U] = np.arctan2(v[0], v[1]), np.hypot(*v)
+                    x[:2] = a.x[:2] + rng.normal(0, 2, 2)
+                else:  # merge_distance_m off the earlier track's position at its time
+                    length, x[ekf.U], t = 5.0, 0.0, a.t_s
+                    if rng.uniform() < 0.5:  # exactly on the limit (positions on a 1/1024 m grid: exact sums)
+                        near = max(cfg.merge_distance_m, 0.5 * (a.length_m + length))
+                        x[:2] = a.x[:2] + near * np.array([1.0, 0.0])[::rng.choice([1, -1])]
+                    else:
+                        angle = rng.uniform(0, 2 * np.pi)
+                        x[:2] = a.x[:2] + cfg.merge_distance_m * (1 + rng.choice([-1e-16, 0.0, 1e-16])) * \
+                            np.array([np.sin(angle), np.cos(angle)])
+                    x[ekf.PSI], x[ekf.U] = a.x[ekf.PSI], a.x[ekf.U]
+                    n_edge += 1
+            tracks.append(Track(k + 1, "radar", x, np.eye(6), t, t, t, confirmed=True, length_m=length))
+        pairs = _same_object_pairs(tracks, cfg)
+        assert pairs == _same_object_pairs_one_by_one(tracks, cfg)
+        n_pairs += len(pairs)
+    assert n_pairs > 50 and n_edge > 50
