@@ -133,8 +133,8 @@ _DENSE_WORD_FRACTION = 0.25
 #: Bits in one 64-bit word (bit planes).
 _BITS_PER_WORD = 64
 #: A blocking level's CUTs are counted on its bit plane when they number at least this fraction of the
-#: sweep's cells (a plane reads every cell once; on 2048 x 1024 sweeps packing one took 0.1-0.2 ms and
-#: counting 77 000 CUTs on it 0.6 ms, on the bytes about 3.5 ms).
+#: cells (a plane reads every cell once; on a 2048 x 1024 sweep packing one took 0.1-0.2 ms and counting
+#: 77 000 CUTs on it 0.6 ms, on the bytes about 3.5 ms).
 _BIT_PLANE_MIN_FRACTION = 1.0 / 128
 #: Cells per chunk of the byte-parallel count (bounded temporaries that stay in cache: chunk x 8 bytes each).
 _WORD_CHUNK_CELLS = 1 << 15
@@ -243,8 +243,8 @@ def _count_training_at_least(levels: np.ndarray, flat: np.ndarray, blocking: np.
     half, guard : int
         N/2 training and G guard cells a side.
 
-    The CUTs of a level L shared by at least ``_BIT_PLANE_MIN_FRACTION`` of the sweep's cells (on a
-    sea sweep, most CUTs share L = 1) are counted on the bit plane ``levels >= L``
+    The CUTs of a level L shared by at least ``_BIT_PLANE_MIN_FRACTION`` of the cells of ``levels`` (on
+    a sea sweep, most CUTs share L = 1) are counted on the bit plane ``levels >= L``
     (:func:`_count_on_bit_plane`), the others on the bytes (:func:`_count_on_words`).
     """
     count = np.empty(flat.size, dtype=np.int64)
@@ -289,6 +289,22 @@ def _count_on_bit_plane(plane: np.ndarray, flat: np.ndarray, half: int, guard: i
     return np.bitwise_count(x).astype(np.int64)
 
 
+def _os_counts_by_table(levels: np.ndarray, rows: np.ndarray, cols: np.ndarray, blocking: np.ndarray,
+                        table: np.ndarray) -> np.ndarray:
+    """(M,) int64: how many training cells of each CUT (``rows``, ``cols``) (M,) reach its blocking level.
+
+    ``levels`` (S, N) C-contiguous uint8 video, ``blocking`` (16,) :func:`_os_blocking_level`, ``table``
+    (N, N_train) :func:`training_table`; the training values are read by flat index, in chunks.
+    """
+    flat_levels, n_samples = levels.reshape(-1), levels.shape[1]
+    count = np.empty(rows.size, dtype=np.int64)
+    for lo in range(0, rows.size, _CHUNK_CELLS):
+        r, c = rows[lo:lo + _CHUNK_CELLS].astype(np.int64), cols[lo:lo + _CHUNK_CELLS]
+        train = flat_levels[(r * n_samples)[:, None] + table[c]]
+        count[lo:lo + _CHUNK_CELLS] = np.count_nonzero(train >= blocking[levels[r, c]][:, None], axis=1)
+    return count
+
+
 def _cfar_cells(echo: np.ndarray, rows: np.ndarray, cols: np.ndarray, config: RadarFrontEndConfig,
                 first: int) -> np.ndarray:
     """(M,) bool CFAR decisions for the cells (rows, cols) of ``echo``.
@@ -313,6 +329,10 @@ def _cfar_cells(echo: np.ndarray, rows: np.ndarray, cols: np.ndarray, config: Ra
         count = _count_training_at_least(echo, flat, blocking[echo.reshape(-1)[flat]], half, guard)
         out[i] = count < need
         todo = np.flatnonzero(~interior)
+        if echo.flags.c_contiguous:  # the cells near the ends
+            table = training_table(n_samples, first, config.training_cells, guard)
+            out[todo] = _os_counts_by_table(echo, rows[todo], cols[todo], blocking, table) < need
+            return out
     power_table = video_power_table(config.video_threshold_db, config.video_step_db)
     for start in range(0, todo.size, _CHUNK_CELLS):
         j = todo[start:start + _CHUNK_CELLS]

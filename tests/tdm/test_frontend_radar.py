@@ -18,7 +18,7 @@ from scipy import ndimage
 from tdm.frames import EnuFrame, Mount, OwnshipTrack
 from tdm.frontend import radar, radar_cfar, radar_clutter, radar_plots
 from tdm.frontend.radar import (RadarFrontEndConfig, _filled_between_detections, _label_max_min, _label_runs,
-                                _numbered_by_first, _run_cells, beam_integrated_power, ca_alpha,
+                                _numbered_by_first, _run_cells, _spokes_per_label, beam_integrated_power, ca_alpha,
                                 cfar_mask, clutter_map, fill_gaps, label_plots, mount_from_scenario, os_alpha,
                                 radar_detections, training_table, video_power)
 from tdm.io import read_ownship, read_truth
@@ -211,7 +211,7 @@ def test_clutter_level_from_the_padded_block_maxima_equals_the_annulus_quantile(
         assert np.array_equal(radar_clutter._clutter_level_db(block_db, bi, bj, config), np.float32(expected))
 
 
-def test_runs_labels_and_per_label_extremes_equal_the_cell_labels_and_ndimage():
+def test_runs_labels_spokes_and_per_label_extremes_equal_the_cell_labels_and_ndimage():
     rng = np.random.default_rng(16)
     for trial in range(30):
         shape = (int(rng.integers(1, 12)), int(rng.integers(1, 20)))
@@ -223,6 +223,8 @@ def test_runs_labels_and_per_label_extremes_equal_the_cell_labels_and_ndimage():
         expected, n = radar_plots._label_cells(flat, *shape)
         assert np.array_equal(pos, np.arange(flat.size)) and np.array_equal(spoke, flat // shape[1])
         assert np.array_equal(lab, expected) and runs.n == n, trial
+        assert np.array_equal(_spokes_per_label(runs.label, runs.spoke, n + 1, shape[0]),
+                              radar_plots._spokes_per_label(lab, spoke, n + 1, shape[0]))
         for values in (rng.normal(size=flat.size), flat % shape[1]):
             largest, smallest = _label_max_min(values, lab - 1, n)
             assert np.array_equal(largest, ndimage.maximum(values, lab - 1, np.arange(n)))
