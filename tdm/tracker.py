@@ -372,6 +372,8 @@ def _same_object_pairs(tracks: list[Track], cfg: TrackerConfig) -> list[tuple[in
     than ``merge_distance_m`` or half their summed lengths. Decided for all pairs at once (elementwise the same
     operations as one pair's); a distance within a rounding error of the limit is decided again pair by pair.
     """
+    if len(tracks) < 2:
+        return []
     ia, ib = np.nonzero(_moving_alike(tracks, cfg.merge_speed_mps))
     if ia.size == 0:
         return []
