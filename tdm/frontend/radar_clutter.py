@@ -145,10 +145,14 @@ def _block_max_db(integrated: np.ndarray, group_spokes: int, config: RadarFrontE
     if (sb * ba, nb * bn) != (a, n):
         padded = np.ones((sb * ba, nb * bn), dtype=np.float32)
         padded[:a, :n] = integrated
-    rows_max = np.maximum.reduce(padded.reshape(sb, ba, nb * bn), axis=1).reshape(sb, nb, bn)
-    block_max = rows_max[:, :, 0].copy()
-    for j in range(1, bn):  # across the bn samples of a block: bn - 1 element-wise maxima (no short inner axis)
-        np.maximum(block_max, rows_max[:, :, j], out=block_max)
+    rows = padded.reshape(sb, ba, nb * bn)
+    rows_max = rows[:, 0].copy()
+    for i in range(1, ba):  # element-wise maxima over the block's rows and then its samples: no short reduced axis
+        np.maximum(rows_max, rows[:, i], out=rows_max)
+    samples = rows_max.reshape(sb, nb, bn)
+    block_max = samples[:, :, 0].copy()
+    for j in range(1, bn):
+        np.maximum(block_max, samples[:, :, j], out=block_max)
     return 10.0 * np.log10(np.maximum(block_max, np.float32(BLOCK_POWER_FLOOR))), ba
 
 
@@ -221,7 +225,8 @@ def _margin_over_clutter_db(lab: np.ndarray, spoke: np.ndarray, sample: np.ndarr
     peak_cell = at_peak[first]
     peak_db = 10.0 * np.log10(peak[labels])
     block_db, ba = _block_max_db(integrated, g, config)
-    level_db = _clutter_level_db(block_db, row[peak_cell] // ba,
-                                 sample[cells[peak_cell]] // config.clutter_block_samples, config)
-    margin_db[labels] = peak_db - level_db
+    block = (row[peak_cell] // ba) * block_db.shape[1] + sample[cells[peak_cell]] // config.clutter_block_samples
+    block, plot_block = np.unique(block, return_inverse=True)  # plots sharing a block share its level
+    level_db = _clutter_level_db(block_db, *np.divmod(block, block_db.shape[1]), config)
+    margin_db[labels] = peak_db - level_db[plot_block]
     return margin_db

@@ -211,6 +211,46 @@ def test_clutter_level_from_the_padded_block_maxima_equals_the_annulus_quantile(
         assert np.array_equal(radar_clutter._clutter_level_db(block_db, bi, bj, config), np.float32(expected))
 
 
+def reference_block_max_db(integrated: np.ndarray, ba: int, bn: int) -> np.ndarray:
+    """Block maxima (dB) one block at a time; a block cut by the sweep's edge is padded with the floor (1)."""
+    sb, nb = -(-integrated.shape[0] // ba), -(-integrated.shape[1] // bn)
+    block_max = np.ones((sb, nb), dtype=np.float32)
+    for i in range(sb):
+        for j in range(nb):
+            part = integrated[i * ba:(i + 1) * ba, j * bn:(j + 1) * bn]
+            whole = part.shape == (ba, bn)
+            block_max[i, j] = part.max() if whole else max(part.max(), np.float32(1.0))
+    return 10.0 * np.log10(np.maximum(block_max, np.float32(radar_clutter.BLOCK_POWER_FLOOR)))
+
+
+def test_margin_over_clutter_equals_each_plots_peak_over_its_blocks_clutter_level():
+    rng = np.random.default_rng(18)
+    config = RadarFrontEndConfig(clutter_window_blocks=(7, 3), clutter_guard_blocks=(3, 1))
+    for n_spokes, n_samples, g in ((64, 60, 4), (48, 64, 8)):
+        integrated = (1.0 + rng.exponential(3.0, (n_spokes // g, n_samples))).astype(np.float32)
+        integrated[rng.random(integrated.shape) < 0.2] = 30.0  # ties: the first cell at the peak decides its block
+        spoke, sample = (a.ravel() for a in np.indices((n_spokes, n_samples)))
+        lab = rng.integers(1, 40, spoke.size)
+        eligible = rng.random(40) < 0.7
+        margin = radar_clutter._margin_over_clutter_db(lab, spoke, sample, 40, eligible, integrated, g, config)
+        ba, bn = max(1, config.clutter_block_spokes // g), config.clutter_block_samples
+        block_db = reference_block_max_db(integrated, ba, bn)
+        assert np.array_equal(radar_clutter._block_max_db(integrated, g, config)[0], block_db)
+        a = integrated.shape[0]
+        before, here = integrated[(spoke // g - 1) % a, sample], integrated[spoke // g, sample]
+        value = np.where(np.maximum(before, here) >= np.float32(10.0), np.maximum(before, here), -np.inf)
+        for label in range(40):
+            cells = np.flatnonzero(lab == label)
+            if not eligible[label] or cells.size == 0 or not np.isfinite(value[cells]).any():
+                assert margin[label] == -np.inf
+                continue
+            peak = cells[np.argmax(value[cells])]  # the first of the cells at the peak
+            row = (spoke[peak] // g - 1) % a if before[peak] > here[peak] else spoke[peak] // g
+            level = reference_clutter_level_db(block_db, row // ba, sample[peak] // bn, config)
+            peak_db = 10.0 * np.log10(np.array([value[peak]], dtype=np.float32))
+            assert margin[label] == np.float32(peak_db - np.float32(level))[0], label
+
+
 def test_runs_labels_spokes_and_per_label_extremes_equal_the_cell_labels_and_ndimage():
     rng = np.random.default_rng(16)
     for trial in range(30):
