@@ -127,9 +127,9 @@ def _training_values(source: np.ndarray, rows: np.ndarray, cols: np.ndarray, con
 
 #: One in every byte of a 64-bit word: a byte value times it fills every byte (byte-parallel counting).
 _BYTE_ONES = np.uint64(0x0101010101010101)
-#: Above this fraction of non-zero words, :func:`_nonzero_flat` reads every byte (on 2048 x 1024 sweeps the
-#: word path took 0.4 of the time at 11 % non-zero words, 1.6 times it at 73 %).
-_DENSE_WORD_FRACTION = 0.25
+#: Above this fraction of non-zero words, :func:`_nonzero_flat` reads every byte (on blocks of 256 x 1024
+#: cells the word path took 0.5-0.9 of the time at 4-10 % non-zero words, 1.0 at 12 %, 1.8-2.8 at 70 %).
+_DENSE_WORD_FRACTION = 0.1
 #: Bits in one 64-bit word (bit planes).
 _BITS_PER_WORD = 64
 #: A blocking level's CUTs are counted on its bit plane when they number at least this fraction of the
@@ -163,10 +163,10 @@ def _nonzero_flat(levels: np.ndarray) -> np.ndarray:
     ``np.flatnonzero``.
     """
     words = _aligned_words(levels)
-    nonzero_words = np.flatnonzero(words)
+    nonzero_words = np.flatnonzero(words != 0)  # on booleans: np.nonzero's fast path, 3-5 times faster
     if nonzero_words.size > _DENSE_WORD_FRACTION * words.size:
-        return np.flatnonzero(levels)
-    byte = np.flatnonzero(words[nonzero_words].view(np.uint8))
+        return np.flatnonzero(levels.reshape(-1) != 0)
+    byte = np.flatnonzero(words[nonzero_words].view(np.uint8) != 0)
     return (nonzero_words[byte >> 3] << 3) | (byte & (_BYTES_PER_WORD - 1))
 
 
