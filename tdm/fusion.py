@@ -39,7 +39,7 @@ import numpy as np
 
 from tdm import ekf
 from tdm.association import chi2_gate, gnn, mahalanobis2
-from tdm.tracker import Track
+from tdm.tracker import Track, predicted_at
 
 
 #: Classes of targets that do not move: an ended one is looked for where it was for ``revive_still_s``.
@@ -287,7 +287,7 @@ class Fuser:
         """:meth:`step`, with the fused estimates of the step kept (:meth:`_estimate`)."""
         cfg = self.config
         live = {(s, tr.track_id): tr for s, trs in tracks_by_sensor.items() for tr in trs}
-        states = {key: tr.predicted(t_s) for key, tr in live.items()}
+        states = dict(zip(live, predicted_at(list(live.values()), t_s)))  # at once; kept for the output
         if own_position_m is not None and cfg.radar_hidden_depth_fraction > 0.0:
             self._behind_the_face(states, live, np.asarray(own_position_m, dtype=float)[:2])
         # keep members that still exist and stay close to the rest of their target

@@ -183,13 +183,24 @@ class Track:
         they were: the fusion and the output ask for the same epoch. The arrays are shared: not to be
         changed in place.
         """
+        kept = self.kept_prediction(t_s)
+        if kept is not None:
+            return kept
+        out = ekf.predict(self.x, self.p, t_s - self.t_s, self.process)
+        self.keep_prediction(t_s, out)
+        return out
+
+    def kept_prediction(self, t_s: float) -> tuple[np.ndarray, np.ndarray] | None:
+        """The kept prediction to ``t_s`` (:meth:`predicted`), if it is still the track's; else None."""
         last = self._last_prediction
         if last is not None and last[0] == t_s and last[1] is self.x and last[2] is self.p and last[3] == self.t_s \
                 and last[4] is self.process:
             return last[5]
-        out = ekf.predict(self.x, self.p, t_s - self.t_s, self.process)
-        self._last_prediction = (t_s, self.x, self.p, self.t_s, self.process, out)
-        return out
+        return None
+
+    def keep_prediction(self, t_s: float, prediction: tuple[np.ndarray, np.ndarray]) -> None:
+        """Keep ``prediction``, the state (6,) and covariance (6, 6) of :meth:`predicted` to ``t_s``, for the next call."""
+        self._last_prediction = (t_s, self.x, self.p, self.t_s, self.process, prediction)
 
     def reported(self, t_s: float) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`predicted`, with the uncertainty of the object's centre behind the side the sensor sees
@@ -208,6 +219,18 @@ class Track:
         if self.extent_sigma_fraction > 0.0 and np.isfinite(self.length_m) and self.length_m > 0.0:
             return float((self.extent_sigma_fraction * self.length_m) ** 2)
         return 0.0
+
+
+def predicted_at(tracks: list[Track], t_s: float) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Each track's :meth:`Track.predicted` to ``t_s``: those not kept formed at once (:func:`tdm.ekf.predict_many`,
+    bit for bit the one-by-one prediction) and kept."""
+    todo = [tr for tr in tracks if tr.kept_prediction(t_s) is None]
+    if len(todo) > 1 and all(tr.process is todo[0].process for tr in todo):
+        xs, ps = ekf.predict_many(np.array([tr.x for tr in todo]), np.array([tr.p for tr in todo]),
+                                  [t_s - tr.t_s for tr in todo], todo[0].process)
+        for tr, x, p in zip(todo, xs, ps):
+            tr.keep_prediction(t_s, (x, p))
+    return [tr.predicted(t_s) for tr in tracks]
 
 
 class PositionTracker:
@@ -243,7 +266,7 @@ class PositionTracker:
             # mean predicted to each detection's own time; covariance at the scan's mean time
             dt = dets.time_s[None, :] - np.array([t.t_s for t in tracks])[:, None]
             pred = ekf.predict_mean(states[:, None, :], dt)
-            p_pos = np.array([t.predicted(t_scan)[1][:2, :2] for t in tracks])
+            p_pos = np.array([p[:2, :2] for _, p in predicted_at(tracks, t_scan)])
             s = p_pos[:, None] + cov[None, :]
             cost = mahalanobis2(pos[None, :, :] - pred[..., :2], s)
             pairs = gnn(cost, self._gate)

@@ -163,3 +163,21 @@ def test_one_angle_wraps_as_the_array_form():
         assert ekf.wrap_pi(float(a)).tobytes() == ekf.wrap_pi(np.array([a]))[0].tobytes()
         assert ekf.wrap_pi(a).tobytes() == ekf.wrap_pi(np.array([a]))[0].tobytes()
     assert np.isnan(ekf.wrap_pi(float("nan")))
+
+
+def test_many_states_are_predicted_bit_for_bit_as_one_by_one():
+    """predict_many gives the very bytes of predict for each state (batched BLAS products, elementwise numpy on the
+    scalar path's operations), with zero intervals and a non-finite state among them."""
+    q = ekf.ProcessNoise()
+    x, dt = _random_states(2000, seed=12)
+    rng = np.random.default_rng(13)
+    m = rng.normal(size=(len(x), 6, 6))
+    p = m @ m.transpose(0, 2, 1) + np.eye(6)
+    dts = dt.tolist()
+    dts[3] = dts[10] = 0.0
+    x[17, ekf.U] = np.nan
+    for lo, hi in ((0, 1), (0, 2), (0, 37), (37, 2000)):
+        xs, ps = ekf.predict_many(x[lo:hi], p[lo:hi], dts[lo:hi], q)
+        for k in range(lo, hi):
+            x1, p1 = ekf.predict(x[k], p[k], dts[k], q)
+            assert xs[k - lo].tobytes() == x1.tobytes() and ps[k - lo].tobytes() == p1.tobytes(), k
