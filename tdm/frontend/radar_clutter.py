@@ -41,7 +41,8 @@ def _windows(groups: np.ndarray, g: int) -> np.ndarray:
     rows_per_part = max(1, _WINDOW_PART_CELLS // max(1, groups.shape[1]))
     for lo in range(0, groups.shape[0], rows_per_part):  # parts: small temporaries
         hi = min(lo + rows_per_part, groups.shape[0])
-        part = groups[lo:hi] + np.concatenate([groups[lo + 1:hi + 1], groups[:max(0, hi + 1 - groups.shape[0])]])
+        after = groups[lo + 1:hi + 1] if hi < groups.shape[0] else np.concatenate([groups[lo + 1:hi], groups[:1]])
+        part = groups[lo:hi] + after
         part *= 0.5 / g
         np.add(part, 1.0, out=window[lo:hi])  # in float64, then rounded to float32 once
     return window
