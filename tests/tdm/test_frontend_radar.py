@@ -118,8 +118,7 @@ def test_gap_filling_joins_detections_along_a_run_of_echo_only():
 
 def random_video(rng: np.random.Generator, shape: tuple[int, int], p_zero: float) -> np.ndarray:
     """(S, N) uint8 video levels: 0 with probability ``p_zero``, else uniform over 1..15."""
-    levels = rng.integers(1, 16, size=shape, dtype=np.uint8)
-    return np.where(rng.random(shape) < p_zero, 0, levels).astype(np.uint8)
+    return np.where(rng.random(shape) < p_zero, 0, rng.integers(1, 16, size=shape)).astype(np.uint8)
 
 
 @pytest.mark.parametrize("bit_plane_fraction", [0.0, 0.05, math.inf])  # every level / common levels / none on planes
@@ -135,8 +134,7 @@ def test_byte_parallel_os_counts_equal_the_counts_of_the_gathered_training_cells
         if trial % 3 == 1:
             echo = echo[:, 1:]  # not C-contiguous, nor a whole number of words: the copied words
         first = int(rng.integers(0, 3))
-        rows, cols = np.nonzero(np.ones(echo.shape, dtype=bool))
-        rows, cols = rows[cols >= first], cols[cols >= first]
+        rows, cols = np.nonzero(np.broadcast_to(np.arange(echo.shape[1]) >= first, echo.shape))
         train = radar_cfar._training_values(echo, rows, cols, config, first)
         blocking = radar_cfar._os_blocking_level(config.alpha, config.video_threshold_db, config.video_step_db)
         expected = np.count_nonzero(train >= blocking[echo[rows, cols]][:, None], axis=1) < n_training - config.rank + 1
@@ -155,8 +153,7 @@ def test_gap_filling_between_neighbouring_detections_equals_filling_each_run():
     rng = np.random.default_rng(13)
     for trial in range(40):
         n_samples = int(rng.integers(1, 40))
-        strong = rng.random((int(rng.integers(1, 9)), n_samples)) < rng.choice([0.3, 0.8, 1.0])
-        flat = np.flatnonzero(strong)
+        flat = np.flatnonzero(rng.random((int(rng.integers(1, 9)), n_samples)) < rng.choice([0.3, 0.8, 1.0]))
         detected = rng.random(flat.size) < rng.choice([0.05, 0.3, 0.7])
         expected = detected | radar_plots._fill_runs(flat, n_samples, detected)
         assert np.array_equal(detected | _filled_between_detections(flat, detected, n_samples), expected), trial
@@ -184,8 +181,7 @@ def test_plot_cells_by_blocks_of_spokes_equal_cfar_gap_filling_and_integration_o
         echo[:, 600:640] = rng.integers(3, 8, size=(n_spokes, 40))  # extended echoes: runs to fill
         flat, integrated, g = radar._plot_cells(echo, RANGE_M, config)
         first = int(np.searchsorted(RANGE_M, config.blanking_m))
-        blanked = echo.copy()
-        blanked[:, :first] = 0
+        blanked = np.where(np.arange(SAMPLES) < first, 0, echo).astype(np.uint8)
         expected = fill_gaps(cfar_mask(blanked, config, RANGE_M), blanked, config.fill_level)
         assert np.array_equal(flat, np.flatnonzero(expected))
         expected_integrated, expected_g = beam_integrated_power(video_power(blanked, config).astype(np.float64), config)
@@ -215,11 +211,9 @@ def reference_block_max_db(integrated: np.ndarray, ba: int, bn: int) -> np.ndarr
     """Block maxima (dB) one block at a time; a block cut by the sweep's edge is padded with the floor (1)."""
     sb, nb = -(-integrated.shape[0] // ba), -(-integrated.shape[1] // bn)
     block_max = np.ones((sb, nb), dtype=np.float32)
-    for i in range(sb):
-        for j in range(nb):
-            part = integrated[i * ba:(i + 1) * ba, j * bn:(j + 1) * bn]
-            whole = part.shape == (ba, bn)
-            block_max[i, j] = part.max() if whole else max(part.max(), np.float32(1.0))
+    for i, j in np.ndindex(sb, nb):
+        part = integrated[i * ba:(i + 1) * ba, j * bn:(j + 1) * bn]
+        block_max[i, j] = part.max() if part.shape == (ba, bn) else max(part.max(), np.float32(1.0))
     return 10.0 * np.log10(np.maximum(block_max, np.float32(radar_clutter.BLOCK_POWER_FLOOR)))
 
 
@@ -230,13 +224,11 @@ def test_margin_over_clutter_equals_each_plots_peak_over_its_blocks_clutter_leve
         integrated = (1.0 + rng.exponential(3.0, (n_spokes // g, n_samples))).astype(np.float32)
         integrated[rng.random(integrated.shape) < 0.2] = 30.0  # ties: the first cell at the peak decides its block
         spoke, sample = (a.ravel() for a in np.indices((n_spokes, n_samples)))
-        lab = rng.integers(1, 40, spoke.size)
-        eligible = rng.random(40) < 0.7
+        lab, eligible = rng.integers(1, 40, spoke.size), rng.random(40) < 0.7
         margin = radar_clutter._margin_over_clutter_db(lab, spoke, sample, 40, eligible, integrated, g, config)
-        ba, bn = max(1, config.clutter_block_spokes // g), config.clutter_block_samples
+        (ba, bn), a = (max(1, config.clutter_block_spokes // g), config.clutter_block_samples), integrated.shape[0]
         block_db = reference_block_max_db(integrated, ba, bn)
         assert np.array_equal(radar_clutter._block_max_db(integrated, g, config)[0], block_db)
-        a = integrated.shape[0]
         before, here = integrated[(spoke // g - 1) % a, sample], integrated[spoke // g, sample]
         value = np.where(np.maximum(before, here) >= np.float32(10.0), np.maximum(before, here), -np.inf)
         for label in range(40):
@@ -247,11 +239,12 @@ def test_margin_over_clutter_equals_each_plots_peak_over_its_blocks_clutter_leve
             peak = cells[np.argmax(value[cells])]  # the first of the cells at the peak
             row = (spoke[peak] // g - 1) % a if before[peak] > here[peak] else spoke[peak] // g
             level = reference_clutter_level_db(block_db, row // ba, sample[peak] // bn, config)
-            peak_db = 10.0 * np.log10(np.array([value[peak]], dtype=np.float32))
-            assert margin[label] == np.float32(peak_db - np.float32(level))[0], label
+            assert margin[label] == (10.0 * np.log10(value[[peak]].astype(np.float32)) - np.float32(level))[0], label
 
 
 def test_runs_labels_spokes_and_per_label_extremes_equal_the_cell_labels_and_ndimage():
+    numbered = [_numbered_by_first(np.array(c)).tolist() for c in ([2, 2, 0, 1, 0, 2], [0, 1, 0, 2, 1])]
+    assert numbered == [[0, 0, 1, 2, 1, 0], [0, 1, 0, 2, 1]]  # renumbered in the order of first appearance; already so
     rng = np.random.default_rng(16)
     for trial in range(30):
         shape = (int(rng.integers(1, 12)), int(rng.integers(1, 20)))
@@ -269,12 +262,6 @@ def test_runs_labels_spokes_and_per_label_extremes_equal_the_cell_labels_and_ndi
             largest, smallest = _label_max_min(values, lab - 1, n)
             assert np.array_equal(largest, ndimage.maximum(values, lab - 1, np.arange(n)))
             assert np.array_equal(smallest, ndimage.minimum(values, lab - 1, np.arange(n)))
-
-
-def test_components_numbered_by_their_first_run_whatever_order_they_come_in():
-    comp = np.array([2, 2, 0, 1, 0, 2])
-    assert _numbered_by_first(comp).tolist() == [0, 0, 1, 2, 1, 0]
-    assert _numbered_by_first(np.array([0, 1, 0, 2, 1])).tolist() == [0, 1, 0, 2, 1]
 
 
 # ------------------------------------------------------------------ labels, plots of synthetic sweeps
