@@ -22,6 +22,7 @@ import numpy as np
 from tdm.detections import Detections, ReadStats
 from tdm.frontend.lidar import lidar_detections
 from tdm.frontend.radar import radar_detections
+from tdm.frontend.radar_sidelobes import drop_sidelobes
 from tdm.land import drop_on_land
 from tdm.recording.npz import Unreadable
 from tdm.recording.sweep_files import SweepOrder
@@ -82,7 +83,7 @@ def _frontend(job: tuple[str, object]) -> FrontendResult:
     if sensor == "lidar":
         dets = lidar_detections(sweep, _WORKER["track"], mount, cfg, land)
     else:
-        dets = radar_detections(sweep, _WORKER["track"], mount, cfg)
+        dets = drop_sidelobes(radar_detections(sweep, _WORKER["track"], mount, cfg), _WORKER["track"], mount, cfg)
     beam = (cfg.land_beam_fraction, cfg.beam_az_deg) if sensor == "radar" else (0.0, 0.0)
     dets = drop_on_land(dets, land, *beam)  # radar: also within half a beam of the land
     return sensor, float(np.min(times)), float(np.max(times)), dets, None, path

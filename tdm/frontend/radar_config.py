@@ -120,6 +120,20 @@ class RadarFrontEndConfig:
         Default 0.5: half the -3 dB beamwidth either side of a coast face, out to where the one-way pattern is
         3 dB (two-way 6 dB) under its peak (a radar's azimuth resolution is its beamwidth); 0 turns it off.
         Not fitted to any scenario: the figure is the beam's.
+    sidelobe_margin_db : float or None
+        A plot at least this much weaker (strength over the local clutter) than another of the scan at
+        the same range, in its sidelobes, is that plot's sidelobe echo and is dropped
+        (:mod:`tdm.frontend.radar_sidelobes`); None turns the rule off. Default 10 dB: the antenna's
+        two-way sidelobes are 40 dB and more under its main lobe beyond 6 deg (docs/radar.md,
+        "Antenna"), which the 45 dB of log video and the strongest echoes' saturation compress; 10 dB
+        keeps a target that is merely somewhat weaker. Not fitted to a scenario.
+    sidelobe_range_gate_m : float
+        Plots this close in range count as at the same range. Default 10 m (four range resolutions:
+        two plots' centroids over one extended echo).
+    sidelobe_offset_deg : (float, float)
+        Bearing offsets of the sidelobe region, deg. Default (5.2, 60): from one beamwidth (inside it,
+        the two plots are one echo's) to where the two-way pattern (-70 dB) puts even a saturating
+        echo under the video floor (docs/radar.md, "Antenna").
     range_scale_m, spokes, samples : float, int, int or None
         The sweep geometry the configuration is for (scenario ``sensors.radar``); when set,
         :func:`radar_detections` checks each sweep against it.
@@ -154,6 +168,9 @@ class RadarFrontEndConfig:
     bearing_sigma_beam_fraction: float = 0.15
     extent_sigma_fraction: float = 0.25
     land_beam_fraction: float = 0.5
+    sidelobe_margin_db: float | None = 10.0
+    sidelobe_range_gate_m: float = 10.0
+    sidelobe_offset_deg: tuple[float, float] = (5.2, 60.0)
     range_scale_m: float | None = None
     spokes: int | None = None
     samples: int | None = None

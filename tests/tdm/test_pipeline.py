@@ -105,8 +105,8 @@ def test_busy_open_sea_meets_the_done_criteria(busy):
     assert metrics["parameters"]["radar_visibility"] == "rays"
 
 
-@ISSUE_19_FAILS
 def test_busy_open_sea_has_at_most_one_false_target_a_minute(busy):
+    """Failed (strict xfail) until the radar front end dropped sidelobe-arc plots (docs/tdm.md, "Sidelobe arcs")."""
     _, metrics = busy
     assert metrics["false_targets_per_min"] <= 1.0, metrics["false_target_ids"]
 
