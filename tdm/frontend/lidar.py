@@ -20,8 +20,8 @@ Steps (all vectorised; the only Python loop is over ring offsets):
 5. **Voxels.** Points are binned into vertical columns ("pillars", 2D voxels) of
    ``voxel_m`` on the horizontal plane (``np.unique`` of integer keys, with a count per
    voxel); each voxel is represented by the mean of its points.
-6. **Clustering.** A graph on voxels, cut into connected components
-   (``scipy.sparse.csgraph.connected_components``), has two kinds of edge:
+6. **Clustering.** A graph on voxels, cut into connected components (:func:`_components`, the
+   labels of ``scipy.sparse.csgraph.connected_components``), has two kinds of edge:
 
    * Euclidean (PCL/Autoware): voxel centres closer than ``cluster_tolerance_m`` on the
      horizontal plane (``cKDTree.query_pairs``). Clustering on the horizontal plane
@@ -92,8 +92,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.sparse import csr_array
-from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from tdm.detections import Detections
@@ -366,18 +364,33 @@ def _cluster_labels(inverse: np.ndarray, centres: np.ndarray, ring: np.ndarray, 
     between = link_i != link_j
     rows = np.concatenate([pairs[:, 0], link_i[between]])
     cols = np.concatenate([pairs[:, 1], link_j[between]])
-    _, voxel_label = connected_components(_adjacency(rows, cols, n_voxels), directed=False)
-    return voxel_label[inverse], on_surface
+    return _components(rows, cols, n_voxels)[inverse], on_surface
 
 
-def _adjacency(rows: np.ndarray, cols: np.ndarray, n: int) -> csr_array:
-    """(n, n) sparse adjacency of the edges ``rows[k] -> cols[k]`` (E,), built straight in CSR form (edges
-    sorted by row, a row pointer from their counts): the graph ``csr_array((ones, (rows, cols)))`` gives,
-    without its COO detour. Repeated edges stay repeated, which connected components do not mind."""
-    order = np.argsort(rows, kind="stable")
-    indptr = np.zeros(n + 1, dtype=np.int32)
-    np.cumsum(np.bincount(rows, minlength=n), out=indptr[1:])
-    return csr_array((np.ones(rows.shape[0]), cols[order].astype(np.int32), indptr), shape=(n, n))
+def _components(rows: np.ndarray, cols: np.ndarray, n: int) -> np.ndarray:
+    """(n,) connected component of each of ``n`` nodes joined by the undirected edges ``rows[k] - cols[k]`` (E,),
+    numbered in the order of each component's lowest node: the labels of
+    ``scipy.sparse.csgraph.connected_components`` (which numbers components as its scan over the nodes
+    meets them), without its per-call graph checks.
+
+    Min-label hooking with pointer jumping (Shiloach & Vishkin, "An O(log n) parallel connectivity
+    algorithm", J. Algorithms 3(1), 1982): every node points at a node of no higher index; each round
+    hooks the root of each edge's higher end on the lower, then every pointer jumps to its root. A
+    component's lowest node never moves, so at the end it is every member's root.
+    """
+    parent = np.arange(n)
+    while rows.size:  # a few rounds: each at least halves the trees' depth
+        low = np.minimum(parent[rows], parent[cols])
+        np.minimum.at(parent, parent[rows], low)
+        np.minimum.at(parent, parent[cols], low)
+        while True:  # pointer jumping until every node points at its root
+            jumped = parent[parent]
+            if np.array_equal(jumped, parent):
+                break
+            parent = jumped
+        if np.array_equal(parent[rows], parent[cols]):
+            break
+    return np.unique(parent, return_inverse=True)[1].reshape(-1)
 
 
 def _kept_clusters(label: np.ndarray, on_surface: np.ndarray, config: LidarFrontEndConfig

@@ -342,20 +342,21 @@ def test_busy_open_sea_every_well_seen_object_gives_a_cluster_near_it(bos_record
     assert checked > 200
 
 
-def test_the_adjacency_built_in_csr_form_is_the_coo_built_graph():
+@pytest.mark.parametrize("n, e", [(1, 0), (60, 0), (60, 80), (300, 250), (500, 3000), (2000, 1999)])
+def test_connected_components_are_scipys_with_its_numbering(n, e):
     from scipy.sparse import csr_array
     from scipy.sparse.csgraph import connected_components
 
-    from tdm.frontend.lidar import _adjacency
+    from tdm.frontend.lidar import _components
 
-    rng = np.random.default_rng(5)
-    rows, cols = rng.integers(0, 60, 80), rng.integers(0, 60, 80)
-    rows[:5] = cols[:5] = 7  # self loops and repeated edges
-    direct = _adjacency(rows, cols, 60)
-    via_coo = csr_array((np.ones(80), (rows, cols)), shape=(60, 60))
-    assert np.array_equal(direct.toarray(), via_coo.toarray())
-    assert np.array_equal(connected_components(direct, directed=False)[1],
-                          connected_components(via_coo, directed=False)[1])
+    rng = np.random.default_rng(n + e)
+    rows, cols = rng.integers(0, n, e), rng.integers(0, n, e)
+    if e == n - 1:  # one long chain in shuffled order: the deepest trees
+        order = rng.permutation(n)
+        rows, cols = order[:-1], order[1:]
+    rows[:3], cols[:3] = rows[:3], rows[:3]  # self loops
+    graph = csr_array((np.ones(e), (rows, cols)), shape=(n, n))
+    assert np.array_equal(_components(rows, cols, n), connected_components(graph, directed=False)[1])
 
 
 def test_a_mount_pose_is_formed_once_and_is_the_mounts():
