@@ -191,21 +191,23 @@ def test_the_centres_uncertainty_weighs_the_output_only_when_asked(weigh):
     np.testing.assert_array_equal(radar.predicted(0.0)[1], make_track(2, "radar", 4.0, 100.0, var=4.0).p)
 
 
-def _moving_track(track_id, sensor, east, north, course_deg, speed_mps, speed_sigma_mps, mmsi=None):
+def _moving_track(track_id, sensor, east, north, course_deg, speed_mps, speed_sigma_mps, mmsi=None,
+                  heading_sigma_deg=2.0):
     track = make_track(track_id, sensor, east, north, var=4.0, mmsi=mmsi)
     track.x[ekf.PSI], track.x[ekf.U] = np.radians(course_deg), speed_mps
-    track.p[ekf.U, ekf.U], track.p[ekf.PSI, ekf.PSI] = speed_sigma_mps**2, np.radians(2.0) ** 2
+    track.p[ekf.U, ekf.U], track.p[ekf.PSI, ekf.PSI] = speed_sigma_mps**2, np.radians(heading_sigma_deg) ** 2
     return track
 
 
-@pytest.mark.parametrize("speed_sigma_mps, folds", [(0.3, False), (3.0, True)])
-def test_a_ship_crossing_inside_an_ais_ships_footprint_keeps_its_target(speed_sigma_mps, folds):
-    """crossing_silent_ship: a silent ship (west at 3.5 m/s, tracked long: speed known to 0.3 m/s) passes 20 m
-    from a 60 m AIS ferry going north at 6 m/s: two objects, each keeps its id. A new radar track of the ferry's
-    bow with an unknown speed (3 m/s) at the same place folds into the ferry."""
+@pytest.mark.parametrize("speed_sigma_mps, heading_sigma_deg, folds", [(0.3, 2.0, False), (3.0, 60.0, True)])
+def test_a_ship_crossing_inside_an_ais_ships_footprint_keeps_its_target(speed_sigma_mps, heading_sigma_deg, folds):
+    """crossing_silent_ship: a silent ship (west at 3.5 m/s, tracked long: speed known to 0.3 m/s, heading to
+    2 deg) passes 20 m from a 60 m AIS ferry going north at 6 m/s: two objects, each keeps its id. A new radar
+    track of the ferry's bow with an unknown velocity (speed to 3 m/s, heading to 60 deg) at the same place folds
+    into the ferry."""
     fuser = Fuser(FusionConfig())
     fuser.lengths_by_mmsi = {257000112: 60.0}
-    crosser = _moving_track(1, "radar", 20.0, 0.0, 270.0, 3.5, speed_sigma_mps)
+    crosser = _moving_track(1, "radar", 20.0, 0.0, 270.0, 3.5, speed_sigma_mps, heading_sigma_deg=heading_sigma_deg)
     ferry = _moving_track(5, "ais", 0.0, 0.0, 0.0, 6.0, 0.2, mmsi=257000112)
     out = fuser.step(1.0, {"radar": [crosser]})
     crosser_id = out[0].target.target_id
@@ -217,6 +219,28 @@ def test_a_ship_crossing_inside_an_ais_ships_footprint_keeps_its_target(speed_si
         assert len(out) == 2
         (silent,) = [e for e in out if e.target.mmsi is None]
         assert silent.target.target_id == crosser_id and silent.sources == ["radar"]
+
+
+@pytest.mark.parametrize("heading_sigma_deg, speed_sigma_mps, course_deg, speed_mps, apart", [
+    (30.6, 0.62, 270.0, 3.62, True),   # crossing_silent_ship seed 35: a coasting crosser, heading uncertain
+    (2.0, 0.3, 270.0, 3.5, True),      # a crosser tracked long
+    (30.0, 3.0, 10.0, 5.0, False),     # a new fragment of the ferry: near its velocity, uncertain
+    (2.0, 0.3, 5.0, 5.5, False),       # the ferry's own fragment, well known: within the 2 m/s margin
+    (60.0, 3.0, 270.0, 3.5, False),    # nothing known of the crosser's velocity: it may be the ferry's
+])
+def test_moves_apart_weighs_the_velocity_difference_in_the_targets_own_velocity_covariance(
+        heading_sigma_deg, speed_sigma_mps, course_deg, speed_mps, apart):
+    """The ferry goes north at 6.9 m/s. On seed 35 the first form of the rule (speed error plus speed times
+    heading error, 2.03 m/s, in every direction) let the coasting crosser, 8 m/s off in velocity, fold in."""
+    from tdm.fusion import _moves_apart
+
+    ferry = np.zeros(6), np.eye(6)
+    ferry[0][ekf.PSI], ferry[0][ekf.U] = np.radians(2.0), 6.9
+    other = np.zeros(6), np.zeros((6, 6))
+    other[0][ekf.PSI], other[0][ekf.U] = np.radians(course_deg), speed_mps
+    other[1][ekf.U, ekf.U], other[1][ekf.PSI, ekf.PSI] = speed_sigma_mps**2, np.radians(heading_sigma_deg) ** 2
+    assert _moves_apart(ferry, other, True) is apart
+    assert _moves_apart(other, ferry, False) is apart
 
 
 def test_footprint_test_decides_as_the_reference_also_at_its_edge():
