@@ -69,6 +69,12 @@ class Detections:
     def __len__(self) -> int:
         return int(self.time_s.shape[0])
 
+    def subset(self, keep: np.ndarray) -> "Detections":
+        """The detections where ``keep`` (N,) bool is True, every per-detection array cut alike."""
+        n = len(self)
+        return Detections(**{name: (value[keep] if isinstance(value, np.ndarray) and value.shape[:1] == (n,)
+                                    else value) for name, value in vars(self).items()})
+
     @classmethod
     def empty(cls, sensor: str, scan_time_s: float) -> "Detections":
         z = np.zeros(0)

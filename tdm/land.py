@@ -130,12 +130,7 @@ def drop_on_land(detections: Detections, mask: LandMask | None, beam_fraction: f
         if near.size:
             distance = shapely.distance(mask.geometry, shapely.points(east[near], north[near]))
             keep[near[distance <= margin[near]]] = False
-    if keep.all():
-        return detections
-    n = len(detections)
-    fields = {name: (value[keep] if isinstance(value, np.ndarray) and value.shape[:1] == (n,) else value)
-              for name, value in vars(detections).items()}
-    return Detections(**fields)
+    return detections if keep.all() else detections.subset(keep)
 
 
 def on_chart_land(land: ChartLand | None, lat_deg, lon_deg) -> np.ndarray:

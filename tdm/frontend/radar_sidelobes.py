@@ -87,8 +87,4 @@ def drop_sidelobes(plots: Detections, track: OwnshipTrack, mount: Mount, config)
     sensor_m = track.sensor_to_enu(np.zeros((len(plots), 3)), plots.time_s, mount)[:, :2]
     drop = sidelobe_plots(plots.position_m, sensor_m, plots.range_m, plots.strength_db,
                           config.sidelobe_range_gate_m, *config.sidelobe_offset_deg, margin_db)
-    if not drop.any():
-        return plots
-    n, keep = len(plots), ~drop
-    return Detections(**{name: (value[keep] if isinstance(value, np.ndarray) and value.shape[:1] == (n,) else value)
-                         for name, value in vars(plots).items()})
+    return plots.subset(~drop) if drop.any() else plots

@@ -11,11 +11,10 @@
 A file of up to :data:`IN_MEMORY_MAX_BYTES` is read in one system call. When it is a plain archive of
 stored (uncompressed) members, which is how ``np.savez`` and raysim write sweeps, its directory is read
 from those bytes (:mod:`tdm.recording.zip_stored`) and each member's data sliced out of them, its
-CRC-32 checked as ``zipfile`` checks it; otherwise ``zipfile`` reads the directory (and says what is
-wrong with a damaged one), stored members still coming from the bytes. Each ``.npy`` header is read
-by a fast parser of numpy's own header text (anything else goes to numpy's parser). Compressed
-members and larger files go through ``zipfile``'s streams. Every route gives the same arrays and the
-same errors (tests/tdm/test_recording.py).
+CRC-32 checked as ``zipfile`` checks it; any other archive (compressed, damaged, larger) is read by
+``zipfile``, which also says what is wrong with a damaged one. Each ``.npy`` header is read by a fast
+parser of numpy's own header text (anything else goes to numpy's parser). Both routes give the same
+arrays and the same errors (tests/tdm/test_recording.py).
 
 A file that cannot be read as such an archive at all (zero bytes, not a zip, cut short, damaged
 member data or header) raises :class:`Unreadable` with a short reason: what copying or a crash
@@ -51,9 +50,6 @@ MAX_ARRAY_BYTES = 1 << 30
 MAX_HEADER_BYTES = 1 << 16
 #: Files up to this size are read whole, in one system call (a radar sweep is 2 MiB, a LiDAR sweep 0.6 MiB).
 IN_MEMORY_MAX_BYTES = 1 << 28
-#: A zip local file header: its signature and fixed length; the name and extra field lengths at 26 and 28.
-_LOCAL_HEADER_SIGNATURE = b"PK\x03\x04"
-_LOCAL_HEADER_BYTES = 30
 #: The header text numpy writes (``np.lib.format``): ``{'descr': '<f4', 'fortran_order': False, 'shape': (3,), }``
 #: padded with spaces to a newline. Texts of another form go to numpy's parser.
 _NUMPY_HEADER_TEXT = re.compile(rb"\{'descr': '([<>|=]?[biufc]\d{1,2})', 'fortran_order': (True|False), "
@@ -197,15 +193,15 @@ def _member_header(zf: zipfile.ZipFile | None, info: zipfile.ZipInfo | StoredMem
 
 def _member_stream(zf: zipfile.ZipFile | None, info: zipfile.ZipInfo | StoredMember, data: bytes | None,
                    check_crc: bool = True):
-    """A stream over a member's data: from the bytes in memory when the member is stored (its CRC-32
-    checked unless ``check_crc`` is false), else :meth:`zipfile.ZipFile.open` (which checks it at the end)."""
-    if isinstance(info, StoredMember):
-        member = memoryview(data)[info.data_start:info.data_start + info.file_size]
-        if check_crc and zlib.crc32(member) != info.CRC:
-            raise zipfile.BadZipFile(f"bad CRC-32 for {info.filename}")
-        return _MemberView(member)
-    stored = _stored_member(data, info, check_crc)
-    return stored if stored is not None else zf.open(info)
+    """A stream over a member's data: from the bytes in memory for a member of a plain stored archive
+    (:class:`StoredMember`; its CRC-32 checked unless ``check_crc`` is false), else
+    :meth:`zipfile.ZipFile.open` (which checks it at the end)."""
+    if not isinstance(info, StoredMember):
+        return zf.open(info)
+    member = memoryview(data)[info.data_start:info.data_start + info.file_size]
+    if check_crc and zlib.crc32(member) != info.CRC:
+        raise zipfile.BadZipFile(f"bad CRC-32 for {info.filename}")
+    return _MemberView(member)
 
 
 class _MemberView:
@@ -231,33 +227,6 @@ class _MemberView:
 
     def __exit__(self, *exc) -> None:
         self._view.release()
-
-
-def _stored_member(data: bytes | None, info: zipfile.ZipInfo, check_crc: bool = True) -> _MemberView | None:
-    """A stored (uncompressed) member of an archive read whole, as a stream over its bytes, its
-    CRC-32 checked (unless ``check_crc`` is false); None for a compressed member or an archive not in
-    memory.
-
-    Raises
-    ------
-    zipfile.BadZipFile
-        The local header is not where the directory says, the member runs past the file's end, or its
-        CRC-32 is not the directory's (what ``zipfile`` raises for the same faults).
-    """
-    if data is None or info.compress_type != zipfile.ZIP_STORED:
-        return None
-    at = info.header_offset
-    local = data[at:at + _LOCAL_HEADER_BYTES]
-    if len(local) != _LOCAL_HEADER_BYTES or local[:4] != _LOCAL_HEADER_SIGNATURE:
-        raise zipfile.BadZipFile("no local file header where the directory points")
-    start = at + _LOCAL_HEADER_BYTES + int.from_bytes(local[26:28], "little") + int.from_bytes(local[28:30], "little")
-    end = start + info.compress_size
-    if end > len(data):
-        raise zipfile.BadZipFile("member runs past the end of the file")
-    member = memoryview(data)[start:end]
-    if check_crc and zlib.crc32(member) != info.CRC:
-        raise zipfile.BadZipFile(f"bad CRC-32 for {info.filename}")
-    return _MemberView(member)
 
 
 class NpzFile:
