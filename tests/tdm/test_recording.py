@@ -5,6 +5,7 @@ from __future__ import annotations
 import io
 import pickle
 import zipfile
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -189,3 +190,33 @@ def test_a_plain_stored_archives_directory_is_read_as_zipfile_reads_it(tmp_path)
     assert stored_members(b"junk" + data) is None
     assert stored_members(data[:-30] + data[-22:]) is None
     assert stored_members(data[:10]) is None
+
+
+@pytest.mark.parametrize("bad", [None, "nan", "inf", "below", "above", "early", "late", "at_bounds"])
+@pytest.mark.parametrize("dtype", ["float32", "float64"])
+def test_sweep_values_pass_on_their_extremes_alone_and_fail_as_the_checks_one_by_one(bad, dtype):
+    """check_values' shortcut (least and greatest value) passes exactly the arrays the checks one by one pass,
+    and a failing array still gets the message naming its first bad value."""
+    from groundfloor.recording import ArraySpec, SweepSchema
+    from tdm.recording.sweeps import _plainly_good, check_values
+    spec = ArraySpec("v", dtype, ("points",), low=-2.0, high=3.0)
+    schema = SweepSchema("lidar", (spec, ArraySpec("time", "float64", ("points",))))
+    window_s = (10.0, 20.0)
+    rng = np.random.default_rng(5)
+    v = rng.uniform(-1.9, 2.9, 50).astype(dtype)
+    time = rng.uniform(10.5, 19.5, 50)
+    place = {"nan": ("v", np.nan), "inf": ("v", np.inf), "below": ("v", -2.5), "above": ("v", 3.5),
+             "early": ("time", 9.0), "late": ("time", 21.0)}.get(bad)
+    if bad == "at_bounds":
+        v[3], v[4], time[5], time[6] = -2.0, 3.0, 10.0, 20.0
+    if place is not None:
+        (v if place[0] == "v" else time)[17] = place[1]
+    arrays = {"v": v, "time": time}
+    one_by_one_passes = not (~np.isfinite(v) | (v < -2.0) | (v > 3.0)).any() and not ((time < 10) | (time > 20)).any()
+    shortcut = all(_plainly_good(n, a, schema.spec(n), window_s) for n, a in arrays.items())
+    assert shortcut == one_by_one_passes == (bad in (None, "at_bounds"))
+    if one_by_one_passes:
+        check_values(Path("s.npz"), arrays, schema, window_s)
+    else:
+        with pytest.raises(RecordingError, match=f"s.npz: {place[0]}: .* at index 17"):
+            check_values(Path("s.npz"), arrays, schema, window_s)
