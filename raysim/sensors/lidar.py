@@ -30,6 +30,7 @@ from raysim.recording.velodyne import PcapWriter, encode_data_packets, encode_po
 from raysim.scene import NO_HIT, SEA_ID, intersect_sea
 from raysim.sea import FoamField
 from raysim.sensors import lidar_physics as phys
+from raysim.sensors.blas_threads import single_blas_thread
 from raysim.sensors.carrier import CarrierScene
 from raysim.sensors.context import SensorContext
 from raysim.world import World
@@ -486,7 +487,8 @@ class LidarRenderer:
             az_blocks = (np.repeat(block_az, DUAL_RETURNS) if self.dual else block_az).reshape(-1, blocks)
             firing_az = hdl32e.decoder_azimuths_centideg(az_blocks, dual=self.dual)
             firing_az = firing_az[:, ::2] if self.dual else firing_az
-            fire = self.measure(t, block_az, firing_az.reshape(-1, hdl32e.N_LASERS))
+            with single_blas_thread():  # the chunk's matrix products are small (raysim.sensors.blas_threads)
+                fire = self.measure(t, block_az, firing_az.reshape(-1, hdl32e.N_LASERS))
             payloads = self.packets(fire)
             sent = t[:: self.cycles_per_packet] + self.cycles_per_packet * hdl32e.CYCLE_DT_S
             # position packets due within this chunk go in time order with the data packets
