@@ -161,7 +161,7 @@ def _range_image_links(ring: np.ndarray, points_m: np.ndarray, range_m: np.ndarr
     n_bins = int(math.ceil(2.0 * math.pi / step_rad)) + _SPARE_AZIMUTH_BINS
     azimuth_bin = ((np.arctan2(points_m[:, 1], points_m[:, 0]) + math.pi) / step_rad).astype(np.int64)
     key = ring * n_bins + azimuth_bin
-    order = np.argsort(key)
+    order = np.argsort(key, kind="stable")
     sorted_key = key[order]
     range2 = range_m * range_m
     tan2 = math.tan(math.radians(config.ring_link_angle_deg)) ** 2
