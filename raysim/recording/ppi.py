@@ -10,6 +10,7 @@ and ring spacing, receiver settings (gain, sea and rain control).
 from __future__ import annotations
 
 import datetime as dt
+import threading
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -83,9 +84,22 @@ def _nm(metres: float) -> str:
     return f"{round(metres / METRES_PER_NM, 3):g}"
 
 
+_FONTS = threading.local()
+#: Index no picture uses: the unpainted pixels of an overlay's canvas (:func:`_overlay`).
+BLANK_INK = 255
+
+
+def _font() -> ImageFont.FreeTypeFont | ImageFont.ImageFont:
+    """Pillow's bundled font at FONT_PX, loaded once per thread (a FreeType face is not shared across threads)."""
+    font = getattr(_FONTS, "font", None)
+    if font is None:
+        font = _FONTS.font = ImageFont.load_default(size=FONT_PX)
+    return font
+
+
 def _corner_text(draw: ImageDraw.ImageDraw, size_px: int, corner: str, lines: list[str]) -> None:
     """Write ``lines`` into ``corner`` (``"tl"``, ``"tr"``, ``"bl"``, ``"br"``), outside the display circle."""
-    font = ImageFont.load_default(size=FONT_PX)
+    font = _font()
     top = corner[0] == "t"
     for k, line in enumerate(lines):
         y = 6 + k * LINE_PX if top else size_px - 6 - (len(lines) - k) * LINE_PX
@@ -93,20 +107,31 @@ def _corner_text(draw: ImageDraw.ImageDraw, size_px: int, corner: str, lines: li
         draw.text((x, y), line, fill=TEXT_INK, font=font)
 
 
-def _annotate(draw: ImageDraw.ImageDraw, size_px: int, range_m: np.ndarray, heading_deg: float,
-              time_s: float | None, labels: PpiLabels | None) -> None:
-    """Corner texts: heading (top left), time (top right), range (bottom left), receiver (bottom right)."""
-    labels = labels or PpiLabels()
-    _corner_text(draw, size_px, "tl", ["N up", f"HDG {heading_deg % 360.0:05.1f}\N{DEGREE SIGN}"])
+def _changing_corners(heading_deg: float, time_s: float | None, labels: PpiLabels) -> dict[str, list[str]]:
+    """Corner texts that change every revolution: heading (top left) and time (top right)."""
+    corners = {"tl": ["N up", f"HDG {heading_deg % 360.0:05.1f}\N{DEGREE SIGN}"]}
     if time_s is not None:
         when = [f"t = {time_s:.1f} s (first spoke)"]
         if labels.start_time is not None:
             utc = labels.start_time.astimezone(dt.timezone.utc) + dt.timedelta(seconds=time_s)
             when.insert(0, utc.strftime("%Y-%m-%d %H:%M:%S.") + f"{utc.microsecond // 100_000} UTC")
-        _corner_text(draw, size_px, "tr", when)
+        corners["tr"] = when
+    return corners
+
+
+def _fixed_corners(range_m: np.ndarray, labels: PpiLabels) -> dict[str, list[str]]:
+    """Corner texts fixed for a display: range scale and rings (bottom left), receiver settings (bottom right)."""
     scale_m = float(range_m[-1])
-    _corner_text(draw, size_px, "bl", [f"range {_nm(scale_m)} NM ({scale_m:g} m)", f"rings {_nm(scale_m / 4)} NM"])
-    _corner_text(draw, size_px, "br", labels.receiver_lines())
+    return {"bl": [f"range {_nm(scale_m)} NM ({scale_m:g} m)", f"rings {_nm(scale_m / 4)} NM"],
+            "br": labels.receiver_lines()}
+
+
+def _annotate(draw: ImageDraw.ImageDraw, size_px: int, range_m: np.ndarray, heading_deg: float,
+              time_s: float | None, labels: PpiLabels | None) -> None:
+    """Corner texts: heading (top left), time (top right), range (bottom left), receiver (bottom right)."""
+    labels = labels or PpiLabels()
+    for corner, lines in {**_changing_corners(heading_deg, time_s, labels), **_fixed_corners(range_m, labels)}.items():
+        _corner_text(draw, size_px, corner, lines)
 
 
 @lru_cache(maxsize=4)
@@ -124,9 +149,64 @@ def _pixel_geometry(size_px: int, samples: int, range_scale_m: float):
     return inside, bins, sample
 
 
+@lru_cache(maxsize=4)
+def _pixel_geometry_by_bin(size_px: int, samples: int, range_scale_m: float):
+    """:func:`_pixel_geometry` ordered by bearing bin, then sample: (P,) flat pixel indices, bins, samples.
+
+    In this order a picture reads the sweep nearly in memory order (spoke by spoke, out along each) and scatters into
+    the picture, which fits in cache: a third less time than reading in picture order.
+    """
+    inside, bins, sample = _pixel_geometry(size_px, samples, range_scale_m)
+    order = np.argsort(bins * samples + sample, kind="stable")
+    return inside[order], bins[order], sample[order]
+
+
+def _overlay(size_px: int, paint) -> tuple[np.ndarray, np.ndarray]:
+    """What ``paint(draw)`` draws on a palette picture: (Q,) flat indices of the painted pixels and (Q,) uint8 inks.
+
+    Pillow draws shapes and text on a palette picture by setting pixels to the ink (no blending, text unsmoothed),
+    so pasting these pixels gives the bytes drawing on the picture itself gives, in the same order of drawing.
+    """
+    canvas = Image.new("P", (size_px, size_px), BLANK_INK)
+    paint(ImageDraw.Draw(canvas))
+    ink = np.asarray(canvas).ravel()
+    painted = np.flatnonzero(ink != BLANK_INK)
+    return painted, ink[painted]
+
+
+@lru_cache(maxsize=8)
+def _rings(size_px: int, ring_labels: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray]:
+    """The range rings and their labels (one per quarter of the scale) as an :func:`_overlay` (cached per display)."""
+    half = size_px / 2.0
+
+    def paint(draw: ImageDraw.ImageDraw) -> None:
+        for quarter, label in zip((1, 2, 3, 4), ring_labels):
+            r = half * quarter / 4
+            draw.ellipse([half - r, half - r, half + r, half + r], outline=RING_INK)
+            draw.text((half + 4, half - r + 2), label, fill=RING_LABEL_INK)
+
+    return _overlay(size_px, paint)
+
+
+@lru_cache(maxsize=8)
+def _fixed_text(size_px: int, bottom_left: tuple[str, ...], bottom_right: tuple[str, ...]) -> tuple[Image.Image, ...]:
+    """The fixed corner texts as (mask "1" picture, bounding box) pairs to paste TEXT_INK through (cached)."""
+    painted, _ = _overlay(size_px, lambda draw: (_corner_text(draw, size_px, "bl", list(bottom_left)),
+                                                 _corner_text(draw, size_px, "br", list(bottom_right))))
+    mask = np.zeros(size_px * size_px, bool)
+    mask[painted] = True
+    picture = Image.fromarray(mask.reshape(size_px, size_px)).convert("1")
+    box = picture.getbbox()
+    return () if box is None else (picture.crop(box), box)
+
+
 def ppi_image(echo: np.ndarray, azimuth_deg: np.ndarray, heading_deg: np.ndarray, range_m: np.ndarray,
               size_px: int = SIZE_PX, time_s: np.ndarray | None = None, labels: PpiLabels | None = None) -> Image.Image:
     """North-up PPI of one sweep, ``size_px`` x ``size_px`` pixels, with its corner texts.
+
+    Drawn in this order: the video, the range rings and their labels, the heading line, the corner texts. What is
+    fixed for a display (rings, labels, range and receiver texts) is drawn once and pasted (:func:`_overlay`): the
+    same bytes as :func:`ppi_image_reference`, which draws everything every time.
 
     Parameters
     ----------
@@ -145,15 +225,51 @@ def ppi_image(echo: np.ndarray, azimuth_deg: np.ndarray, heading_deg: np.ndarray
     """
     spokes, samples = echo.shape
     half = size_px / 2.0
-    flat_inside, bins, sample = _pixel_geometry(size_px, samples, float(range_m[-1]))
-    # the spoke whose true bearing is nearest (at or after) each bearing bin's centre
+    labels = labels or PpiLabels()
+    pixels, bins, sample = _pixel_geometry_by_bin(size_px, samples, float(range_m[-1]))
+    index = (_spoke_of_bin(azimuth_deg, heading_deg, spokes) * samples).take(bins)
+    index += sample
+    level = np.full(size_px * size_px, OUTSIDE, np.uint8)
+    level[pixels] = np.ascontiguousarray(echo, dtype=np.uint8).ravel().take(index)
+    ring_pixels, ring_ink = _rings(size_px, tuple(f"{_nm(range_m[-1] * quarter / 4)} NM" for quarter in (1, 2, 3, 4)))
+    level[ring_pixels] = ring_ink
+    image = Image.fromarray(level.reshape(size_px, size_px))  # "L"; putpalette makes it "P"
+    image.putpalette(_PALETTE_LIST)
+    draw = ImageDraw.Draw(image)
+    h = np.radians(heading_deg[0])
+    draw.line([half, half, half + half * np.sin(h), half - half * np.cos(h)], fill=HEADING_INK)
+    for corner, lines in _changing_corners(float(heading_deg[0]), None if time_s is None else float(time_s[0]),
+                                           labels).items():
+        _corner_text(draw, size_px, corner, lines)
+    fixed = _fixed_corners(range_m, labels)
+    pasted = _fixed_text(size_px, tuple(fixed["bl"]), tuple(fixed["br"]))
+    if pasted:
+        image.paste(TEXT_INK, pasted[1], pasted[0])
+    return image
+
+
+_PALETTE_LIST = IMAGE_PALETTE.ravel().tolist()
+
+
+def _spoke_of_bin(azimuth_deg: np.ndarray, heading_deg: np.ndarray, spokes: int) -> np.ndarray:
+    """(BEARING_BINS,) int64: the spoke whose true bearing is nearest (at or after) each bearing bin's centre."""
     true = (np.asarray(heading_deg, dtype=float) + azimuth_deg) % 360.0
     order = np.argsort(true, kind="stable")
     centres = (np.arange(BEARING_BINS) + 0.5) * (360.0 / BEARING_BINS)
-    spoke_of_bin = order[np.searchsorted(true[order], centres) % spokes]
+    return order[np.searchsorted(true[order], centres) % spokes]
+
+
+def ppi_image_reference(echo: np.ndarray, azimuth_deg: np.ndarray, heading_deg: np.ndarray, range_m: np.ndarray,
+                        size_px: int = SIZE_PX, time_s: np.ndarray | None = None,
+                        labels: PpiLabels | None = None) -> Image.Image:
+    """:func:`ppi_image` drawn the plain way, everything every time (kept as the reference its tests compare to)."""
+    spokes, samples = echo.shape
+    half = size_px / 2.0
+    flat_inside, bins, sample = _pixel_geometry(size_px, samples, float(range_m[-1]))
+    spoke_of_bin = _spoke_of_bin(azimuth_deg, heading_deg, spokes)
     level = np.full(size_px * size_px, OUTSIDE, np.uint8)
     level[flat_inside] = np.ascontiguousarray(echo, dtype=np.uint8).ravel().take(spoke_of_bin[bins] * samples + sample)
-    image = Image.fromarray(level.reshape(size_px, size_px))  # "L"; putpalette makes it "P"
+    image = Image.fromarray(level.reshape(size_px, size_px))
     image.putpalette(IMAGE_PALETTE.ravel().tolist())
     draw = ImageDraw.Draw(image)
     for quarter in (1, 2, 3, 4):
