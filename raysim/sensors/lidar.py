@@ -129,6 +129,18 @@ class LidarChunk:
     position_times_s: list
 
 
+def _add_scaled(total: np.ndarray, change: np.ndarray, scale: np.ndarray) -> None:
+    """``total += change * scale`` in place, over rows: total, change (C, M, 3); scale (3 M,).
+
+    Each cycle's row of 3 M values is one pass (a broadcast over the last axis of 3 would step
+    three values at a time); ``change`` is overwritten.
+    """
+    flat_total, flat = total.view(), change.view()
+    flat_total.shape = flat.shape = (total.shape[0], -1)  # views (an error, never a silent copy)
+    np.multiply(flat, scale, out=flat)
+    np.add(flat_total, flat, out=flat_total)
+
+
 class LidarRenderer:
     """Renders the HDL-32E of a world's own ship.
 
@@ -220,32 +232,48 @@ class LidarRenderer:
         The own-ship pose is evaluated at the C cycle starts and the next one, and
         interpolated linearly to each firing (1.152 us steps): the error of that
         interpolation over 46 us is below 1e-9 rad.
+
+        Parameters
+        ----------
+        cycle_time_s : (C,) float64
+            Start of each firing cycle, s.
+        origins_s, directions_s : (C, 32, K, 3) float64
+            Beam origins (m) and unit directions in the sensor frame.
+
+        Returns
+        -------
+        o_world : (C, 32, K, 3) float64
+            Ray origins in the world, m.
+        d_world : (C, 32, K, 3) float64
+            Unit ray directions in the world.
+        t_firing : (C, 32) float64
+            Time of each firing, s.
         """
         t_edges = np.append(cycle_time_s, cycle_time_s[-1] + hdl32e.CYCLE_DT_S)
         poses = self.world.own_ship.motion.poses(t_edges)
-        rot = poses.rotation() @ self.mount_rotation  # sensor -> world, (C + 1, 3, 3)
-        pos = poses.position_m + np.einsum("nij,j->ni", poses.rotation(), self.mount_translation)
+        body = poses.rotation()  # body -> world, (C + 1, 3, 3)
         c, _, k, _ = directions_s.shape
-        frac = np.repeat(np.arange(hdl32e.N_LASERS) * (hdl32e.FIRING_DT_S / hdl32e.CYCLE_DT_S), k)  # (32 K,)
-        # row-vector form keeps the (C, 32 K, 3) layout contiguous: d_world = d R^T
-        r0t = np.ascontiguousarray(rot[:-1].transpose(0, 2, 1))
-        drt = np.ascontiguousarray((rot[1:] - rot[:-1]).transpose(0, 2, 1))
-        d = directions_s.reshape(c, hdl32e.N_LASERS * k, 3)
-        f = frac[None, :, None]
-        d_world = d @ r0t
-        d_world += (d @ drt) * f
-        # origins in homogeneous coordinates [x, y, z, 1] (the same for every cycle): one affine
-        # product per cycle, o_world = [o, 1] [R^T; p]
-        homogeneous = np.ones((hdl32e.N_LASERS * k, 4))
+        m = hdl32e.N_LASERS * k
+        # row-vector form keeps the (C, 32 K, 3) layout contiguous: d_world = d R^T, o_world = [o, 1] [R^T; p]
+        # (sensor -> world R^T of every edge in one product of (3 (C + 1), 3) rows)
+        rot_t = (body.reshape(-1, 3) @ self.mount_rotation).reshape(c + 1, 3, 3).transpose(0, 2, 1)
+        pos = poses.position_m + np.einsum("nij,j->ni", body, self.mount_translation)
+        a0 = np.empty((c, 4, 3))  # the affine map at each cycle start
+        da = np.empty((c, 4, 3))  # and its change over the cycle
+        a0[:, :3], a0[:, 3] = rot_t[:-1], pos[:-1]
+        np.subtract(rot_t[1:], rot_t[:-1], out=da[:, :3])
+        np.subtract(pos[1:], pos[:-1], out=da[:, 3])
+        # the fraction of the cycle at each firing, for every coordinate of its rays: (3 m,)
+        frac = np.repeat(np.arange(hdl32e.N_LASERS) * (hdl32e.FIRING_DT_S / hdl32e.CYCLE_DT_S), 3 * k)
+        d_world = directions_s.reshape(c, m, 3) @ a0[:, :3]
+        _add_scaled(d_world, directions_s.reshape(c, m, 3) @ da[:, :3], frac)
+        # origins in homogeneous coordinates [x, y, z, 1] (the same for every cycle)
+        homogeneous = np.ones((m, 4))
         homogeneous[:, :3] = origins_s[0].reshape(-1, 3)
-        a0 = np.concatenate([r0t, pos[:-1, None, :]], axis=1)  # (C, 4, 3)
-        da = np.concatenate([drt, (pos[1:] - pos[:-1])[:, None, :]], axis=1)
         o_world = homogeneous @ a0
-        o_world += (homogeneous @ da) * f
-        o_world = o_world.reshape(c, hdl32e.N_LASERS, k, 3)
-        d_world = d_world.reshape(c, hdl32e.N_LASERS, k, 3)
+        _add_scaled(o_world, homogeneous @ da, frac)
         t_firing = cycle_time_s[:, None] + np.arange(hdl32e.N_LASERS)[None, :] * hdl32e.FIRING_DT_S
-        return o_world, d_world, t_firing
+        return o_world.reshape(c, hdl32e.N_LASERS, k, 3), d_world.reshape(c, hdl32e.N_LASERS, k, 3), t_firing
 
     # ------------------------------------------------------------------ physics
 
