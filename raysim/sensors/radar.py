@@ -274,8 +274,10 @@ class RadarRenderer:
             return None
         m, n = power_rows.shape
         blocks = -(-n // SKIRT_BLOCK)
-        padded = np.zeros((m, blocks * SKIRT_BLOCK), np.float32)
-        padded[:, :n] = power_rows
+        padded = np.asarray(power_rows, dtype=np.float32)  # whole blocks: no padded copy (the same sums)
+        if n % SKIRT_BLOCK:
+            padded = np.zeros((m, blocks * SKIRT_BLOCK), np.float32)
+            padded[:, :n] = power_rows
         per_block = padded.reshape(m, blocks, SKIRT_BLOCK).sum(axis=2)
         half = self.range_skirt_blocks.size // 2
         out = fftconvolve(per_block, self.range_skirt_blocks[None, :], mode="full", axes=1)[:, half: half + blocks]
