@@ -202,6 +202,7 @@ class LidarRenderer:
         rng = np.where(hit, hits.range_m, np.inf)
         hit_z = o_b[:, 2] + np.where(hit, hits.range_m, 0.0) * d_b[:, 2]
         return {
+            "hit": hit,
             "range_m": rng.astype(np.float32),
             "power": np.where(hit, phys.echo_power(reflectance * cos_inc, rng, self.alpha), 0.0).astype(np.float32),
             "byte": phys.reflectivity_byte(reflectance, cos_inc, self.materials["retroreflective"][mat] & hit),
@@ -308,21 +309,23 @@ class LidarRenderer:
         own-ship body-frame hits among them).
         """
         t = self.own_table
-        azimuth = firing_azimuth.reshape(-1).astype(np.int64)
-        key = azimuth * hdl32e.N_LASERS + np.tile(np.arange(hdl32e.N_LASERS), azimuth.size // hdl32e.N_LASERS)
-        r_own = t["range_m"][key].astype(np.float64)
-        on_own = np.isfinite(r_own)
-        wet = np.flatnonzero(t["wet"][key])
+        # gathers by np.take: the same values as fancy indexing, several times faster on these sizes
+        key = (firing_azimuth.astype(np.int32) * hdl32e.N_LASERS + np.arange(hdl32e.N_LASERS, dtype=np.int32)).reshape(-1)
+        on_own = np.take(t["hit"], key)
+        wet = np.flatnonzero(np.take(t["wet"], key))
         if wet.size:
-            on_own[wet] &= ~(intersect_sea(rays.origins_m[wet, 2], rays.directions[wet, 2]) < r_own[wet])
+            r_wet = np.take(t["range_m"], np.take(key, wet)).astype(np.float64)
+            sea_m = intersect_sea(np.take(rays.origins_m, wet, axis=0)[:, 2], np.take(rays.directions, wet, axis=0)[:, 2])
+            on_own[wet] &= ~(sea_m < r_wet)
         own = np.flatnonzero(on_own)
-        cand.range_m[own, 0] = r_own[own]
-        cand.power[own, 0] = t["power"][key[own]]
-        cand.byte[own, 0] = t["byte"][key[own]]
-        cand.object_id[own, 0] = t["object_id"]
+        key_own = np.take(key, own)
+        cand.range_m[:, 0][own] = np.take(t["range_m"], key_own)  # float32 -> float64, exact
+        cand.power[:, 0][own] = np.take(t["power"], key_own)
+        cand.byte[:, 0][own] = np.take(t["byte"], key_own)
+        cand.object_id[:, 0][own] = t["object_id"]
         free = np.flatnonzero(~on_own)
-        hits = self.scene.world.cast(rays.origins_m[free], rays.directions[free], rays.times_s[free],
-                                     max_range_m=self.cfg.range_max_m + CAST_RANGE_MARGIN_M)
+        hits = self.scene.world.cast(np.take(rays.origins_m, free, axis=0), np.take(rays.directions, free, axis=0),
+                                     np.take(rays.times_s, free), max_range_m=self.cfg.range_max_m + CAST_RANGE_MARGIN_M)
         return hits, free, None
 
     def _cast_with_own_ship(self, rays: _Rays, origins_s: np.ndarray, directions_s: np.ndarray):
@@ -345,37 +348,42 @@ class LidarRenderer:
         """
         o_w, d_w, times = rays.origins_m, rays.directions, rays.times_s
         hit_local = np.flatnonzero(hits.object_id != NO_HIT)
-        h = free[hit_local]
-        r_h = hits.range_m[hit_local]
-        obj_h = hits.object_id[hit_local]
-        cos_h = np.abs(np.einsum("ij,ij->i", hits.normal[hit_local], d_w[h]))
+        h = np.take(free, hit_local)
+        r_h = np.take(hits.range_m, hit_local)
+        obj_h = np.take(hits.object_id, hit_local)
+        normal_h = np.take(hits.normal, hit_local, axis=0)
+        cos_h = np.abs(np.einsum("ij,ij->i", normal_h, np.take(d_w, h, axis=0)))
         if own_body is not None:  # own-ship normals are in its body frame: use the body-frame direction
             on_carrier, d_b = own_body
             own_h = np.flatnonzero(on_carrier[h])
-            cos_h[own_h] = np.abs(np.einsum("ij,ij->i", hits.normal[hit_local[own_h]], d_b[h[own_h]]))
-        mat_h = hits.material[hit_local]
-        reflectance = self.materials["reflectance_905nm"][mat_h].astype(np.float64)
-        retro = self.materials["retroreflective"][mat_h]
+            cos_h[own_h] = np.abs(np.einsum("ij,ij->i", normal_h[own_h], d_b[h[own_h]]))
+        mat_h = np.take(hits.material, hit_local)
+        reflectance = np.take(self.materials["reflectance_905nm"], mat_h).astype(np.float64)
+        retro = np.take(self.materials["retroreflective"], mat_h)
         source = np.zeros(h.size, dtype=np.uint8)
         sea = obj_h == SEA_ID
-        if sea.any():
-            reflectance[sea] = 0.0  # calm water: a specular mirror, nothing comes back
-            source[sea] = SOURCE_SEA
+        on_sea = np.flatnonzero(sea)
+        if on_sea.size:
+            reflectance[on_sea] = 0.0  # calm water: a specular mirror, nothing comes back
+            source[on_sea] = SOURCE_SEA
             # foam is looked up only where a foam echo could be detected at all
-            could = np.nonzero(sea & (phys.echo_power(FOAM_REFLECTANCE * cos_h, r_h, self.alpha) >= self.threshold))[0]
+            could = np.flatnonzero(sea & (phys.echo_power(FOAM_REFLECTANCE * cos_h, r_h, self.alpha) >= self.threshold))
             if could.size:
-                on_sea = h[could]
-                x = o_w[on_sea, 0] + r_h[could] * d_w[on_sea, 0]
-                y = o_w[on_sea, 1] + r_h[could] * d_w[on_sea, 1]
-                foam = self.foam.is_foam(x, y, times[on_sea])
+                rays_c = np.take(h, could)
+                r_c = np.take(r_h, could)
+                o_c, d_c = np.take(o_w, rays_c, axis=0), np.take(d_w, rays_c, axis=0)
+                foam = self.foam.is_foam(o_c[:, 0] + r_c * d_c[:, 0], o_c[:, 1] + r_c * d_c[:, 1], np.take(times, rays_c))
                 reflectance[could[foam]] = FOAM_REFLECTANCE
         power_h = phys.echo_power(reflectance * cos_h, r_h, self.alpha) / k
-        row, col = h // k, h % k
-        cand.range_m[row, col] = r_h
-        cand.power[row, col] = power_h
-        cand.byte[row, col] = phys.reflectivity_byte(reflectance, cos_h, retro)
-        cand.object_id[row, col] = np.where(sea, -1, obj_h)
-        cand.source[row, col] = source
+        values = ((cand.range_m, r_h), (cand.power, power_h), (cand.byte, phys.reflectivity_byte(reflectance, cos_h, retro)),
+                  (cand.object_id, np.where(sea, -1, obj_h)), (cand.source, source))
+        if k == 1:  # the candidates of column 0, by ray
+            for column, value in values:
+                column[:, 0][h] = value
+        else:
+            row, col = h // k, h % k
+            for column, value in values:
+                column[row, col] = value
 
     def _false_echoes(self, cand: _Candidates, f: int, k: int) -> None:
         """Weather's false echoes near the sensor (fog droplets, rain drops) into candidate column ``k``."""
@@ -402,20 +410,21 @@ class LidarRenderer:
         refl = np.zeros((n_ret, f), dtype=np.uint8)
         oid = np.full((n_ret, f), -1, dtype=np.int32)
         src = np.zeros((n_ret, f), dtype=np.uint8)
+        e = cand.range_m.shape[1]
         for i, pick in enumerate(picks):
-            rows = np.nonzero(pick >= 0)[0]
-            cols = pick[rows]
-            measured = group_r[rows, cols]
+            rows = np.flatnonzero(pick >= 0)
+            flat = rows * e + np.take(pick, rows)  # (row, column) of the picked candidates, flattened
+            measured = np.take(group_r.reshape(-1), flat)
             if self.cfg.range_noise_m > 0:
                 measured = measured + self.noise_rng.normal(0.0, self.cfg.range_noise_m, rows.size)
             q = np.round(measured / hdl32e.DISTANCE_UNIT_M)
-            ok = ((measured >= self.cfg.range_min_m) & (measured <= self.cfg.range_max_m) & (q >= 1)
-                  & (q <= MAX_DISTANCE_UNITS))
-            rows, cols = rows[ok], cols[ok]
-            units[i, rows] = q[ok]
-            refl[i, rows] = cand.byte[rows, cols]
-            oid[i, rows] = cand.object_id[rows, cols]
-            src[i, rows] = cand.source[rows, cols]
+            ok = np.flatnonzero((measured >= self.cfg.range_min_m) & (measured <= self.cfg.range_max_m) & (q >= 1)
+                                & (q <= MAX_DISTANCE_UNITS))
+            rows, flat = np.take(rows, ok), np.take(flat, ok)
+            units[i][rows] = np.take(q, ok)
+            refl[i][rows] = np.take(cand.byte.reshape(-1), flat)
+            oid[i][rows] = np.take(cand.object_id.reshape(-1), flat)
+            src[i][rows] = np.take(cand.source.reshape(-1), flat)
         if self.dual:  # a single echo group: both blocks carry the same measurement
             rows = np.arange(f)
             same = (group_id[rows, np.maximum(picks[0], 0)] == group_id[rows, np.maximum(picks[1], 0)]) & (units[0] > 0)
@@ -437,20 +446,25 @@ class LidarRenderer:
         keep = units > 0
         if self.dual:  # a repeated echo (same distance in both blocks) is one point, as decoders report it
             keep[:, 1] &= units[:, 1] != units[:, 0]
-        cc, rr, jj = np.nonzero(keep)
-        d = units[cc, rr, jj].astype(np.float64) * hdl32e.DISTANCE_UNIT_M
-        az = fire.firing_azimuth[cc, jj]
-        xy = d * hdl32e.COS_ELEVATION[jj]
+        # np.nonzero's (cycle, return, laser) indices from the flat ones; gathers by np.take (same values, faster)
+        flat = np.flatnonzero(keep)
+        per_cycle = units.shape[1] * hdl32e.N_LASERS
+        cc, rest = np.divmod(flat, per_cycle)
+        rr, jj = np.divmod(rest, hdl32e.N_LASERS)
+        gather = lambda a: np.take(a.reshape(-1), flat)  # noqa: E731 (a (C, R, 32) array at the kept returns)
+        d = gather(units).astype(np.float64) * hdl32e.DISTANCE_UNIT_M
+        az = np.take(fire.firing_azimuth.reshape(-1), cc * hdl32e.N_LASERS + jj)
+        xy = d * np.take(hdl32e.COS_ELEVATION, jj)
         arrays = {
-            "x": (xy * hdl32e.COS_AZIMUTH_STEP[az]).astype(np.float32),
-            "y": (-xy * hdl32e.SIN_AZIMUTH_STEP[az]).astype(np.float32),
-            "z": (d * hdl32e.SIN_ELEVATION[jj] + hdl32e.Z_OFFSET_M[jj]).astype(np.float32),
-            "intensity": fire.reflectivity[cc, rr, jj].astype(np.uint8),
-            "ring": hdl32e.RING[jj],
-            "time": fire.cycle_time_s[cc] + jj * hdl32e.FIRING_DT_S,
+            "x": (xy * np.take(hdl32e.COS_AZIMUTH_STEP, az)).astype(np.float32),
+            "y": (-xy * np.take(hdl32e.SIN_AZIMUTH_STEP, az)).astype(np.float32),
+            "z": (d * np.take(hdl32e.SIN_ELEVATION, jj) + np.take(hdl32e.Z_OFFSET_M, jj)).astype(np.float32),
+            "intensity": gather(fire.reflectivity).astype(np.uint8),
+            "ring": np.take(hdl32e.RING, jj),
+            "time": np.take(fire.cycle_time_s, cc) + jj * hdl32e.FIRING_DT_S,
             "azimuth_deg": (az.astype(np.float64) * DEG_PER_CENTIDEG).astype(np.float32),
-            "object_id": fire.object_id[cc, rr, jj].astype(np.int32),
-            "return_source": fire.source[cc, rr, jj].astype(np.uint8),
+            "object_id": gather(fire.object_id).astype(np.int32),
+            "return_source": gather(fire.source).astype(np.uint8),
             "return_index": rr.astype(np.uint8),
         }
         return arrays, cc
