@@ -25,7 +25,7 @@ from tdm.recording.manifest import start_time_unix_s as _start_time_unix_s
 from tdm.recording.description import RecordingDescription, describe
 from tdm.recording.sweep_files import list_sweeps, sweep_window_s
 from tdm.run_config import TdmConfig
-from tdm.workers import detections_in_time_order
+from tdm.workers import BATCH_SCANS, detections_in_time_order
 
 __all__ = ["DetectionStream", "interleaved", "start_time_unix_s"]
 
@@ -143,6 +143,7 @@ class DetectionStream:
         self._initargs = (self.ownship, self.description.lidar.mount, lidar_cfg, self.description.radar.mount,
                           radar_cfg, _sweep_limits(self.description), detection_mask)
         self._jobs = _scan_jobs(rec, config, manifest, self.description, stats)
+        self._chunk_scans = BATCH_SCANS
         ais_path = rec / "ais" / "ais.nmea"
         self.reports, self.static = [], {}
         has_ais = is_present(ais_path)
@@ -159,6 +160,7 @@ class DetectionStream:
         and the own ship from ``ownship`` if given (a track that grows while the stream runs; the front ends
         must then run in this process, ``workers`` 0, to see it grow)."""
         self._jobs = dict(jobs)
+        self._chunk_scans = 1  # each scan on its own as it arrives
         if ownship is not None:
             self.ownship = ownship
             self._initargs = (ownship,) + self._initargs[1:]
@@ -167,7 +169,7 @@ class DetectionStream:
         """(time s, sensor, Detections or AisReport) in time order (a scan at its last point's time)."""
         longest_period_s = max((period for _, period in self._jobs.values()), default=0.0)
         scans = detections_in_time_order(interleaved(self._jobs), longest_period_s, self.config.workers,
-                                         self._initargs, self.stats)
+                                         self._initargs, self.stats, self._chunk_scans)
         return heapq.merge(scans, ((r.time_s, "ais", r) for r in self.reports), key=lambda item: item[0])
 
 

@@ -20,7 +20,7 @@ from typing import Iterable, Iterator
 import numpy as np
 
 from tdm.detections import Detections, ReadStats
-from tdm.frontend.lidar import lidar_detections
+from tdm.frontend.lidar import lidar_detections_batch
 from tdm.frontend.radar import radar_detections
 from tdm.frontend.radar_sidelobes import drop_sidelobes
 from tdm.land import drop_on_land
@@ -33,7 +33,8 @@ __all__ = ["BATCH_SCANS", "LIDAR_FIELDS", "RADAR_FIELDS", "detections_in_time_or
 LIDAR_FIELDS = ("x", "y", "z", "ring", "time")  # what the LiDAR front end reads
 RADAR_FIELDS = ("echo", "azimuth_deg", "heading_deg", "time", "range_m")
 
-#: Scans per worker task: enough to hide the inter-process overhead (about a millisecond a task).
+#: Scans per chunk, a worker task: enough to hide the inter-process overhead (about a millisecond a task)
+#: and numpy's per-call overhead (the chunk's LiDAR sweeps go through their front end together).
 BATCH_SCANS = 16
 #: Batches submitted ahead per worker: the workers never wait for the next batch, and memory stays flat.
 BATCHES_AHEAD_PER_WORKER = 3
@@ -62,55 +63,81 @@ def _read_sweep_file(sensor: str, path: Path) -> dict | str:
         return exc.reason
 
 
-def _frontend(job: tuple[str, object]) -> FrontendResult:
-    """Detections of one scan: (sensor, start and end time s, detections or None, problem or None, file or None).
-
-    A sweep file that breaks the format raises :class:`tdm.errors.RecordingError` (also from a worker).
-    """
+def _read_job(job: tuple[str, object]) -> tuple[dict | None, Path | None, FrontendResult | None]:
+    """A job's sweep (read and checked when it is a file) and file, or the result that says why it has none."""
     sensor, source = job
     path = Path(source) if isinstance(source, (str, Path)) else None
-    if path is not None:
-        sweep = _read_sweep_file(sensor, path)
-        if isinstance(sweep, str):
-            return sensor, -1.0, -1.0, None, unreadable_warning(sensor, sweep), path
-    else:
-        sweep = source
-    times = sweep["time"]
-    if times.size == 0:
-        return sensor, -1.0, -1.0, None, f"{sensor}: empty sweeps", path
-    mount, cfg = _WORKER[sensor]
-    land = _WORKER.get("land")  # the chart's land mask (tdm.land), or None
-    if sensor == "lidar":
-        dets = lidar_detections(sweep, _WORKER["track"], mount, cfg, land)
-    else:
-        dets = drop_sidelobes(radar_detections(sweep, _WORKER["track"], mount, cfg), _WORKER["track"], mount, cfg)
+    sweep = _read_sweep_file(sensor, path) if path is not None else source
+    if isinstance(sweep, str):
+        return None, path, (sensor, -1.0, -1.0, None, unreadable_warning(sensor, sweep), path)
+    if sweep["time"].size == 0:
+        return None, path, (sensor, -1.0, -1.0, None, f"{sensor}: empty sweeps", path)
+    return sweep, path, None
+
+
+def _finished(sensor: str, sweep: dict, dets: Detections, path: Path | None) -> FrontendResult:
+    """A scan's result: its detections off the chart's land (radar: also within half a beam of it)."""
+    cfg = _WORKER[sensor][1]
     beam = (cfg.land_beam_fraction, cfg.beam_az_deg) if sensor == "radar" else (0.0, 0.0)
-    dets = drop_on_land(dets, land, *beam)  # radar: also within half a beam of the land
+    dets = drop_on_land(dets, _WORKER.get("land"), *beam)
+    times = sweep["time"]
     return sensor, float(np.min(times)), float(np.max(times)), dets, None, path
 
 
-def _frontend_batch(batch: list) -> list:
-    return [_frontend(job) for job in batch]
+def _frontend_chunk(jobs: list[tuple[str, object]]) -> list[FrontendResult]:
+    """Detections of consecutive scans, in the jobs' order: each (sensor, start and end time s, detections or
+    None, problem or None, file or None).
+
+    The chunk's LiDAR sweeps go through the front end together (:func:`tdm.frontend.lidar.lidar_detections_batch`,
+    each with the result it has alone), the radar sweeps one by one. A sweep file that breaks the format
+    raises :class:`tdm.errors.RecordingError` (also from a worker).
+    """
+    results: list = [None] * len(jobs)
+    lidar: list = []
+    track, land = _WORKER["track"], _WORKER.get("land")  # land: the chart's mask (tdm.land), or None
+    for k, job in enumerate(jobs):
+        sweep, path, problem = _read_job(job)
+        if problem is not None:
+            results[k] = problem
+        elif job[0] == "lidar":
+            lidar.append((k, sweep, path))
+        else:
+            mount, cfg = _WORKER["radar"]
+            dets = drop_sidelobes(radar_detections(sweep, track, mount, cfg), track, mount, cfg)
+            results[k] = _finished("radar", sweep, dets, path)
+    if lidar:
+        mount, cfg = _WORKER["lidar"]
+        dets = lidar_detections_batch([sweep for _, sweep, _ in lidar], track, mount, cfg, land)
+        for (k, sweep, path), d in zip(lidar, dets):
+            results[k] = _finished("lidar", sweep, d, path)
+    return results
 
 
-def _pooled_results(jobs: Iterable[tuple[str, object]], executor: ProcessPoolExecutor | None,
-                    in_flight: int) -> Iterator[FrontendResult]:
-    """Front-end results of ``jobs`` in submission order: batches of :data:`BATCH_SCANS` with at most
-    ``in_flight`` batches ahead (in this process without an executor)."""
+def _chunks(jobs: Iterable[tuple[str, object]], size: int) -> Iterator[list[tuple[str, object]]]:
+    """``jobs`` in lists of ``size`` consecutive jobs (the last one shorter)."""
+    chunk: list = []
+    for job in jobs:
+        chunk.append(job)
+        if len(chunk) == size:
+            yield chunk
+            chunk = []
+    if chunk:
+        yield chunk
+
+
+def _pooled_results(jobs: Iterable[tuple[str, object]], executor: ProcessPoolExecutor | None, in_flight: int,
+                    chunk_scans: int = BATCH_SCANS) -> Iterator[FrontendResult]:
+    """Front-end results of ``jobs`` in submission order: chunks of ``chunk_scans`` with at most
+    ``in_flight`` chunks ahead (in this process, one chunk at a time, without an executor)."""
     if executor is None:
-        yield from map(_frontend, jobs)
+        for chunk in _chunks(jobs, chunk_scans):
+            yield from _frontend_chunk(chunk)
         return
     pending: deque = deque()
-    batch: list = []
-    for job in jobs:
-        batch.append(job)
-        if len(batch) == BATCH_SCANS:
-            pending.append(executor.submit(_frontend_batch, batch))
-            batch = []
+    for chunk in _chunks(jobs, chunk_scans):
+        pending.append(executor.submit(_frontend_chunk, chunk))
         if len(pending) > in_flight:
             yield from pending.popleft().result()
-    if batch:
-        pending.append(executor.submit(_frontend_batch, batch))
     while pending:
         yield from pending.popleft().result()
 
@@ -146,13 +173,15 @@ def _reordered(results: Iterable[FrontendResult], lag_s: float,
 
 
 def detections_in_time_order(jobs: Iterable[tuple[str, object]], longest_period_s: float, workers: int,
-                             initargs: tuple, stats: ReadStats) -> Iterator[tuple[float, str, Detections]]:
+                             initargs: tuple, stats: ReadStats,
+                             chunk_scans: int = BATCH_SCANS) -> Iterator[tuple[float, str, Detections]]:
     """(end time, sensor, Detections) of every scan of ``jobs``, in time order.
 
-    Jobs (in expected-time order, :func:`tdm.scans.interleaved`) go to ``workers`` processes (0: this
-    process) with a bounded number in flight (memory stays flat, and the trackers start at once);
-    results come back in submission order and pass a reorder buffer one scan period long, which puts
-    them in exact end-time order.
+    Jobs (in expected-time order, :func:`tdm.scans.interleaved`) go in chunks of ``chunk_scans`` to
+    ``workers`` processes (0: this process) with a bounded number in flight (memory stays flat, and the
+    trackers start at once); results come back in submission order and pass a reorder buffer one scan
+    period long, which puts them in exact end-time order. Live mode takes chunks of one scan: a chunk
+    waits for its last scan.
     """
     lag_s = longest_period_s + REORDER_MARGIN_S
     if workers > 0:
@@ -161,8 +190,8 @@ def detections_in_time_order(jobs: Iterable[tuple[str, object]], longest_period_
         executor = None
         _init_worker(*initargs)
     try:
-        yield from _reordered(_pooled_results(jobs, executor, BATCHES_AHEAD_PER_WORKER * max(workers, 1)), lag_s,
-                              stats)
+        yield from _reordered(_pooled_results(jobs, executor, BATCHES_AHEAD_PER_WORKER * max(workers, 1), chunk_scans),
+                              lag_s, stats)
     finally:
         if executor:
             executor.shutdown(cancel_futures=True)

@@ -1,6 +1,7 @@
 """LiDAR front end: one Velodyne revolution in, clusters as :class:`~tdm.detections.Detections` out.
 
-Steps (all vectorised; the only Python loop is over ring offsets):
+Steps (all vectorised, over one sweep or a batch of them, :func:`lidar_clusters_batch`; the graph's
+parts are in :mod:`tdm.frontend.lidar_graph`):
 
 1. **Own ship.** ~85 % of a sweep's points hit the own ship. They are dropped first and
    cheaply by a box test in the body frame (sensor points moved by the mount): a vertical
@@ -20,11 +21,13 @@ Steps (all vectorised; the only Python loop is over ring offsets):
 5. **Voxels.** Points are binned into vertical columns ("pillars", 2D voxels) of
    ``voxel_m`` on the horizontal plane (``np.unique`` of integer keys, with a count per
    voxel); each voxel is represented by the mean of its points.
-6. **Clustering.** A graph on voxels, cut into connected components (:func:`_components`, the
+6. **Clustering.** A graph on voxels, cut into connected components
+   (:func:`~tdm.frontend.lidar_graph.components`, the
    labels of ``scipy.sparse.csgraph.connected_components``), has two kinds of edge:
 
    * Euclidean (PCL/Autoware): voxel centres closer than ``cluster_tolerance_m`` on the
-     horizontal plane (``cKDTree.query_pairs``). Clustering on the horizontal plane
+     horizontal plane (the pairs of ``cKDTree.query_pairs``, found on the voxel grid:
+     :func:`~tdm.frontend.lidar_graph.voxel_pairs`). Clustering on the horizontal plane
      joins the parts of a target seen at different heights.
    * Range-image links (Bogoslavskyi & Stachniss 2016, "Fast range image-based
      segmentation of sparse 3D laser scans for online operation", IROS;
@@ -92,23 +95,19 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from tdm.detections import Detections
 from tdm.frames import Mount, OwnshipTrack
 from tdm.frontend.lidar_config import (HDL32E_FIRING_CYCLE_S, LINK_WINDOW_CYCLES, LidarFrontEndConfig,
                                        lidar_mount_from_scenario)
+from tdm.frontend.lidar_graph import components, range_image_links, voxel_grid, voxel_pairs
 from tdm.land import LandMask
 
-__all__ = ["HDL32E_FIRING_CYCLE_S", "LINK_WINDOW_CYCLES", "LidarFrontEndConfig", "lidar_clusters", "lidar_detections",
-           "lidar_mount_from_scenario"]
+__all__ = ["HDL32E_FIRING_CYCLE_S", "LINK_WINDOW_CYCLES", "LidarFrontEndConfig", "lidar_clusters", "lidar_clusters_batch",
+           "lidar_detections", "lidar_detections_batch", "lidar_mount_from_scenario"]
 
-#: Range-image neighbours lie within this many azimuth steps of each other (a firing cycle apart,
-#: or two when one firing had no return).
-NEIGHBOUR_AZIMUTH_STEPS = 2
-#: Spare azimuth bins per ring in the range image's keys, beyond one revolution (the bins of a
-#: ring stay apart from the next ring's whatever the rounding of the azimuths).
-_SPARE_AZIMUTH_BINS = 8
+#: The sweep arrays the front end reads.
+_FIELDS = ("x", "y", "z", "ring", "time")
 #: Variance of a uniform distribution over a width w: w^2 / 12 (footprint box, azimuth step).
 UNIFORM_VARIANCE_DIVISOR = 12.0
 #: Variance per axis of a uniform disc of diameter d: d^2 / 16 (beam divergence).
@@ -116,84 +115,6 @@ DISC_VARIANCE_DIVISOR = 16.0
 RAD_PER_MRAD = 1e-3
 #: A mount rotation this close to the identity is taken as none (the own-ship test skips the product).
 _IDENTITY_ATOL = 1e-12
-
-
-def _range_image_links(ring: np.ndarray, points_m: np.ndarray, range_m: np.ndarray, t_s: np.ndarray,
-                       config: LidarFrontEndConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Pairs of points on one surface, neighbours in the range image (module docstring, step 6).
-
-    The points are sorted by (ring, azimuth bin of one azimuth step). Along a ring, each
-    point is paired with the next one when it lies within two azimuth steps; across rings,
-    with the point nearest in azimuth (within two steps) of the ring ``step`` above
-    (``step = 1 .. ring_link_max_step``). A pair is kept when ``beta > theta``. With
-    ``p, q`` the two points (ranges ``d1 >= d2``), ``d2 sin a = |p x q| / d1`` and
-    ``d2 cos a = p.q / d1``, so ``d2 sin a > tan(theta) (d1 - d2 cos a)`` reads
-    ``|p x q|^2 > tan^2(theta) (d1^2 - p.q)^2`` (both sides >= 0), with
-    ``|p x q|^2 = |p|^2 |q|^2 - (p.q)^2``: no angles needed. Neighbours must also be
-    fired within ``LINK_WINDOW_CYCLES`` firing cycles of each other: at the sweep's seam,
-    points next to each other in azimuth were fired a revolution apart, and the own ship
-    has moved in between.
-
-    Parameters
-    ----------
-    ring : (N,) int64
-        Laser ring of each point (0 = lowest).
-    points_m : (N, 3) float64
-        Points in the sensor frame, m.
-    range_m : (N,) float64
-        Their ranges, m.
-    t_s : (N,) float64
-        Their times, s.
-
-    Returns
-    -------
-    i, j : (K,) intp
-        Indices of linked points.
-    on_surface : (N,) bool
-        Points linked to a neighbour along their own ring (the same laser's next or
-        previous firing hit the same surface).
-    """
-    n = ring.shape[0]
-    on_surface = np.zeros(n, dtype=bool)
-    if n < 2:
-        return np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.intp), on_surface
-    step_rad = config.azimuth_step_rad
-    n_bins = int(math.ceil(2.0 * math.pi / step_rad)) + _SPARE_AZIMUTH_BINS
-    azimuth_bin = ((np.arctan2(points_m[:, 1], points_m[:, 0]) + math.pi) / step_rad).astype(np.int64)
-    key = ring * n_bins + azimuth_bin
-    order = np.argsort(key, kind="stable")
-    sorted_key = key[order]
-    range2 = range_m * range_m
-    tan2 = math.tan(math.radians(config.ring_link_angle_deg)) ** 2
-    window_s = LINK_WINDOW_CYCLES * HDL32E_FIRING_CYCLE_S
-
-    def same_surface(i, j):
-        dot = np.einsum("ij,ij->i", points_m[i], points_m[j])
-        r2i, r2j = range2[i], range2[j]
-        gap = np.maximum(r2i, r2j) - dot
-        return (r2i * r2j - dot * dot > tan2 * gap * gap) & (np.abs(t_s[i] - t_s[j]) <= window_s)
-
-    # along each ring: successive points in the sorted order
-    close = np.nonzero(sorted_key[1:] - sorted_key[:-1] <= NEIGHBOUR_AZIMUTH_STEPS)[0]
-    i, j = order[close], order[close + 1]
-    linked = same_surface(i, j)
-    firsts, seconds = [i[linked]], [j[linked]]
-    on_surface[firsts[0]] = True
-    on_surface[seconds[0]] = True
-    # across rings
-    for step in range(1, config.ring_link_max_step + 1):
-        query = key + step * n_bins
-        pos = np.searchsorted(sorted_key, query)
-        lo = order[np.maximum(pos - 1, 0)]
-        hi = order[np.minimum(pos, n - 1)]
-        d_lo = np.abs(key[lo] - query)  # in azimuth bins when in the right ring
-        d_hi = np.abs(key[hi] - query)
-        i = np.nonzero(np.minimum(d_lo, d_hi) <= NEIGHBOUR_AZIMUTH_STEPS)[0]
-        j = np.where(d_hi[i] < d_lo[i], hi[i], lo[i])
-        linked = same_surface(i, j)
-        firsts.append(i[linked])
-        seconds.append(j[linked])
-    return np.concatenate(firsts), np.concatenate(seconds), on_surface
 
 
 def lidar_detections(sweep: dict[str, np.ndarray], track: OwnshipTrack, mount: Mount,
@@ -225,6 +146,13 @@ def lidar_detections(sweep: dict[str, np.ndarray], track: OwnshipTrack, mount: M
     return lidar_clusters(sweep, track, mount, config, land)[0]
 
 
+def lidar_detections_batch(sweeps: list[dict[str, np.ndarray]], track: OwnshipTrack, mount: Mount,
+                           config: LidarFrontEndConfig | None = None,
+                           land: LandMask | None = None) -> list[Detections]:
+    """:func:`lidar_detections` of each of several sweeps, computed together (:func:`lidar_clusters_batch`)."""
+    return [result[0] for result in lidar_clusters_batch(sweeps, track, mount, config, land)]
+
+
 def lidar_clusters(sweep: dict[str, np.ndarray], track: OwnshipTrack, mount: Mount,
                    config: LidarFrontEndConfig | None = None,
                    land: LandMask | None = None) -> tuple[Detections, np.ndarray, np.ndarray]:
@@ -244,39 +172,81 @@ def lidar_clusters(sweep: dict[str, np.ndarray], track: OwnshipTrack, mount: Mou
     point_label : (M,) int64
         The detection (row of ``detections``) of each of those points.
     """
+    return lidar_clusters_batch([sweep], track, mount, config, land)[0]
+
+
+def lidar_clusters_batch(sweeps: list[dict[str, np.ndarray]], track: OwnshipTrack, mount: Mount,
+                         config: LidarFrontEndConfig | None = None,
+                         land: LandMask | None = None) -> list[tuple[Detections, np.ndarray, np.ndarray]]:
+    """:func:`lidar_clusters` of several sweeps at once, each as it would be alone.
+
+    The sweeps' points go through every step together, each point tagged with its sweep, which every
+    grouping key leads with (:mod:`tdm.frontend.lidar_graph`): one pass of each array operation for the
+    batch instead of one per sweep, whose cost on the few thousand points a sweep has off the own ship
+    is mostly numpy's per-call overhead. Every operation is element by element, or a sum or extreme
+    over the points of one voxel or cluster in their sweep's order, so each sweep's result is the one
+    :func:`lidar_clusters` gives for it alone (tested).
+
+    Parameters
+    ----------
+    sweeps : list of dict of (N_s,) arrays
+        Revolutions as :func:`lidar_detections` takes them, in any order; their arrays of one
+        name must share a dtype.
+    track, mount, config, land
+        As for :func:`lidar_detections`.
+
+    Returns
+    -------
+    list of (Detections, point_index, point_label)
+        For each sweep, what :func:`lidar_clusters` returns.
+    """
     config = config or LidarFrontEndConfig()
-    time_s = np.asarray(sweep["time"], dtype=np.float64)
-    scan_time_s = float(time_s.min()) if time_s.size else math.nan
-    x, y, z = (np.asarray(sweep[k]) for k in ("x", "y", "z"))
-    idx, sensor_points, t, range_m = _good_returns(_off_ship(x, y, z, mount, config), x, y, z, time_s, config)
+    if len({tuple(np.asarray(s[k]).dtype.str for k in _FIELDS) for s in sweeps}) > 1:  # the arithmetic differs
+        return [lidar_clusters_batch([s], track, mount, config, land)[0] for s in sweeps]
+    times = [np.asarray(s["time"], dtype=np.float64) for s in sweeps]
+    scan_time_s = np.array([float(t.min()) if t.size else math.nan for t in times])
+    n_points = np.array([t.shape[0] for t in times], dtype=np.int64)
+    x, y, z, ring = (np.concatenate([np.asarray(s[k]) for s in sweeps]) for k in ("x", "y", "z", "ring"))
+    sweep_of_point = np.repeat(np.arange(len(sweeps)), n_points)
+    idx, sensor_points, t, range_m = _good_returns(_off_ship(x, y, z, mount, config), x, y, z,
+                                                   np.concatenate(times), config)
     if idx.size == 0:
-        return _nothing(scan_time_s)
+        return [_nothing(s) for s in scan_time_s]
+    sweep = sweep_of_point[idx]
     # 3. deskew: every point with the pose at its own time
-    enu = _sensor_to_enu(track, sensor_points, t if config.deskew else np.full_like(t, scan_time_s), mount,
-                         config.deskew_step_s)
+    enu = _deskewed(track, sensor_points, t if config.deskew else scan_time_s[sweep], sweep, mount,
+                    config.deskew_step_s)
     # 4. sea and foam (and the chart's land)
     above = enu[:, 2] >= config.min_height_m
-    if land is not None:  # the chart's land (tdm.land): its points make no cluster
+    if land is not None and above.any():  # the chart's land (tdm.land): its points make no cluster
         above &= ~land.contains(enu[:, 0], enu[:, 1])
     if not above.any():
-        return _nothing(scan_time_s)
-    enu, sensor_points, t, range_m, idx = enu[above], sensor_points[above], t[above], range_m[above], idx[above]
+        return [_nothing(s) for s in scan_time_s]
+    enu, sensor_points, t, range_m, idx, sweep = (a[above] for a in (enu, sensor_points, t, range_m, idx, sweep))
     # 5., 6. voxels, their graph and its clusters; clusters of too few points or of weather dropped
-    inverse, centres = _voxels(enu, config.voxel_m)
-    ring = np.asarray(sweep["ring"])[idx].astype(np.int64)
-    label, on_surface = _cluster_labels(inverse, centres, ring, sensor_points, range_m, t, config)
+    label, on_surface = _cluster_labels(enu, sweep, ring[idx].astype(np.int64), sensor_points, range_m, t, config)
     good, counts = _kept_clusters(label, on_surface, config)
     if not good.any():
-        return _nothing(scan_time_s)
-    new_id = np.cumsum(good) - 1
+        return [_nothing(s) for s in scan_time_s]
     member = good[label]
-    label = new_id[label[member]]
-    enu, t, idx = enu[member], t[member], idx[member]
-    k = int(good.sum())
+    label = (np.cumsum(good) - 1)[label[member]]
+    enu, t, idx, sweep = enu[member], t[member], idx[member], sweep[member]
     n_cells = counts[good].astype(np.int64)
-    # 7. per-cluster statistics; the sensor at each cluster's time, and the line of sight to the points' mean
+    cluster_sweep = np.zeros(n_cells.shape[0], dtype=np.int64)
+    cluster_sweep[label] = sweep
+    detections = _cluster_detections(enu, t, label, n_cells, scan_time_s[cluster_sweep], track, mount, config)
+    point_start = np.cumsum(n_points) - n_points
+    return _per_sweep(detections, scan_time_s, cluster_sweep, idx - point_start[sweep], label, sweep)
+
+
+def _cluster_detections(enu: np.ndarray, t: np.ndarray, label: np.ndarray, n_cells: np.ndarray,
+                        scan_time_s: np.ndarray, track: OwnshipTrack, mount: Mount,
+                        config: LidarFrontEndConfig) -> dict[str, np.ndarray]:
+    """Step 7: the (k,) per-cluster fields of :class:`Detections` of the member points (``label`` (M,),
+    ``n_cells`` (k,) points a cluster, ``scan_time_s`` (k,) of each cluster's sweep)."""
     fp = _footprints(enu, t, label, n_cells)
-    sensor_enu = track.sensor_to_enu(np.zeros((k, 3)), fp.mean_t if config.deskew else np.full(k, scan_time_s), mount)
+    sensor_enu = track.sensor_to_enu(np.zeros((n_cells.shape[0], 3)), fp.mean_t if config.deskew else scan_time_s,
+                                     mount)
     if config.centre == "outline":
         depth_fraction = np.where(fp.length_m < config.hidden_depth_max_elongation * fp.width_m,
                                   config.hidden_depth_fraction, 0.0)
@@ -286,21 +256,32 @@ def lidar_clusters(sweep: dict[str, np.ndarray], track: OwnshipTrack, mount: Mou
     los_e = centre_e - sensor_enu[:, 0]
     los_n = centre_n - sensor_enu[:, 1]
     horizontal_range_m = np.hypot(los_e, los_n)
-    detections = Detections(
-        sensor="lidar",
-        scan_time_s=scan_time_s,
-        time_s=fp.mean_t,
-        position_m=np.stack([centre_e, centre_n], axis=1),
-        position_cov_m2=_cluster_cov(fp, los_e, los_n, horizontal_range_m, config),
-        cross_section_m2=fp.length_m * fp.width_m,
-        length_m=fp.length_m,
-        width_m=fp.width_m,
-        orientation_deg=np.mod(90.0 - np.degrees(fp.phi_long), 180.0),
-        height_m=fp.height_m,
-        n_cells=n_cells,
-        range_m=horizontal_range_m,
-    )
-    return detections, idx, label
+    return dict(time_s=fp.mean_t, position_m=np.stack([centre_e, centre_n], axis=1),
+                position_cov_m2=_cluster_cov(fp, los_e, los_n, horizontal_range_m, config),
+                cross_section_m2=fp.length_m * fp.width_m, length_m=fp.length_m, width_m=fp.width_m,
+                orientation_deg=np.mod(90.0 - np.degrees(fp.phi_long), 180.0), height_m=fp.height_m,
+                n_cells=n_cells, range_m=horizontal_range_m)
+
+
+def _per_sweep(fields: dict[str, np.ndarray], scan_time_s: np.ndarray, cluster_sweep: np.ndarray,
+               point_index: np.ndarray, point_label: np.ndarray,
+               point_sweep: np.ndarray) -> list[tuple[Detections, np.ndarray, np.ndarray]]:
+    """The batch's clusters (k,) and member points (M,) cut into one (Detections, point_index, point_label)
+    per sweep; clusters and points come sweep by sweep (the graph's keys lead with the sweep)."""
+    bounds = np.arange(scan_time_s.shape[0] + 1)
+    cluster_cut = np.searchsorted(cluster_sweep, bounds)
+    point_cut = np.searchsorted(point_sweep, bounds)
+    out = []
+    for s, scan_time in enumerate(scan_time_s):
+        c0, c1 = int(cluster_cut[s]), int(cluster_cut[s + 1])
+        if c0 == c1:
+            out.append(_nothing(scan_time))
+            continue
+        p0, p1 = int(point_cut[s]), int(point_cut[s + 1])
+        detections = Detections(sensor="lidar", scan_time_s=float(scan_time),
+                                **{name: value[c0:c1] for name, value in fields.items()})
+        out.append((detections, point_index[p0:p1], point_label[p0:p1] - c0))
+    return out
 
 
 def _off_ship(x: np.ndarray, y: np.ndarray, z: np.ndarray, mount: Mount, config: LidarFrontEndConfig) -> np.ndarray:
@@ -339,58 +320,18 @@ def _good_returns(idx: np.ndarray, x: np.ndarray, y: np.ndarray, z: np.ndarray, 
     return idx[ok], sensor_points[ok], t[ok], range_m[ok]
 
 
-def _voxels(enu: np.ndarray, voxel_m: float) -> tuple[np.ndarray, np.ndarray]:
-    """Horizontal voxels (pillars) of the points (step 5): each point's voxel, and the voxels' mean
-    points (V, 2), m."""
-    cell = np.floor(enu[:, :2] / voxel_m).astype(np.int64)
-    cell -= cell.min(axis=0)
-    voxel_key = cell[:, 0] * (int(cell[:, 1].max()) + 1) + cell[:, 1]
-    _, inverse, voxel_count = np.unique(voxel_key, return_inverse=True, return_counts=True)
-    inverse = inverse.reshape(-1)
-    n_voxels = voxel_count.shape[0]
-    centres = np.stack([np.bincount(inverse, enu[:, 0], n_voxels), np.bincount(inverse, enu[:, 1], n_voxels)],
-                       axis=1) / voxel_count[:, None]
-    return inverse, centres
-
-
-def _cluster_labels(inverse: np.ndarray, centres: np.ndarray, ring: np.ndarray, sensor_points: np.ndarray,
+def _cluster_labels(enu: np.ndarray, sweep: np.ndarray, ring: np.ndarray, sensor_points: np.ndarray,
                     range_m: np.ndarray, t: np.ndarray, config: LidarFrontEndConfig) -> tuple[np.ndarray, np.ndarray]:
-    """Each point's cluster (step 6: Euclidean pairs of voxels + ring links, connected components), and
-    whether it lies on a surface along its ring."""
-    n_voxels = centres.shape[0]
-    pairs = cKDTree(centres).query_pairs(config.cluster_tolerance_m, output_type="ndarray")
-    link_i, link_j, on_surface = _range_image_links(ring, sensor_points, range_m, t, config)
-    link_i, link_j = inverse[link_i], inverse[link_j]
+    """Each point's cluster (steps 5 and 6: voxels, Euclidean pairs of voxels + ring links, connected
+    components; numbered sweep by sweep), and whether it lies on a surface along its ring."""
+    grid = voxel_grid(enu, sweep, config.voxel_m, config.cluster_tolerance_m)
+    pair_i, pair_j = voxel_pairs(grid, config.cluster_tolerance_m)
+    link_i, link_j, on_surface = range_image_links(ring, sweep, sensor_points, range_m, t, config)
+    link_i, link_j = grid.inverse[link_i], grid.inverse[link_j]
     between = link_i != link_j
-    rows = np.concatenate([pairs[:, 0], link_i[between]])
-    cols = np.concatenate([pairs[:, 1], link_j[between]])
-    return _components(rows, cols, n_voxels)[inverse], on_surface
-
-
-def _components(rows: np.ndarray, cols: np.ndarray, n: int) -> np.ndarray:
-    """(n,) connected component of each of ``n`` nodes joined by the undirected edges ``rows[k] - cols[k]`` (E,),
-    numbered in the order of each component's lowest node: the labels of
-    ``scipy.sparse.csgraph.connected_components`` (which numbers components as its scan over the nodes
-    meets them), without its per-call graph checks.
-
-    Min-label hooking with pointer jumping (Shiloach & Vishkin, "An O(log n) parallel connectivity
-    algorithm", J. Algorithms 3(1), 1982): every node points at a node of no higher index; each round
-    hooks the root of each edge's higher end on the lower, then every pointer jumps to its root. A
-    component's lowest node never moves, so at the end it is every member's root.
-    """
-    parent = np.arange(n)
-    while rows.size:  # a few rounds: each at least halves the trees' depth
-        low = np.minimum(parent[rows], parent[cols])
-        np.minimum.at(parent, parent[rows], low)
-        np.minimum.at(parent, parent[cols], low)
-        while True:  # pointer jumping until every node points at its root
-            jumped = parent[parent]
-            if np.array_equal(jumped, parent):
-                break
-            parent = jumped
-        if np.array_equal(parent[rows], parent[cols]):
-            break
-    return np.unique(parent, return_inverse=True)[1].reshape(-1)
+    rows = np.concatenate([pair_i, link_i[between]])
+    cols = np.concatenate([pair_j, link_j[between]])
+    return components(rows, cols, grid.keys.shape[0])[grid.inverse], on_surface
 
 
 def _kept_clusters(label: np.ndarray, on_surface: np.ndarray, config: LidarFrontEndConfig
@@ -484,13 +425,14 @@ def _cluster_cov(fp: _Footprint, los_e: np.ndarray, los_n: np.ndarray, horizonta
     return cov
 
 
-def _sensor_to_enu(track: OwnshipTrack, points_sensor_m: np.ndarray, t_s: np.ndarray, mount: Mount,
-                   step_s: float) -> np.ndarray:
-    """:meth:`OwnshipTrack.sensor_to_enu` with the pose taken at the nearest node of a time grid.
+def _deskewed(track: OwnshipTrack, points_sensor_m: np.ndarray, t_s: np.ndarray, sweep: np.ndarray, mount: Mount,
+              step_s: float) -> np.ndarray:
+    """:meth:`OwnshipTrack.sensor_to_enu` with the pose taken at the nearest node of a time grid, per sweep.
 
-    The pose is evaluated exactly at nodes ``step_s`` apart spanning ``t_s`` and each point
-    takes its nearest node: at most ``step_s / 2`` off its own time. With ``step_s = 0`` (or
-    a grid with more nodes than points) every point gets its own pose.
+    For each sweep, the pose is evaluated exactly at nodes ``step_s`` apart from its points' earliest
+    time to their latest, and each point takes its nearest node: at most ``step_s / 2`` off its own
+    time. With ``step_s = 0`` (or a grid with more nodes than the sweep has points) every point of the
+    sweep gets its own pose.
 
     Parameters
     ----------
@@ -498,18 +440,32 @@ def _sensor_to_enu(track: OwnshipTrack, points_sensor_m: np.ndarray, t_s: np.nda
         Points in the sensor frame, m.
     t_s : (N,) float64
         Their times, s.
+    sweep : (N,) int64
+        Each point's sweep, non-decreasing.
 
     Returns
     -------
     (N, 3) float64
         ENU points, m.
     """
-    t0 = float(t_s.min())
-    n_nodes = int(math.ceil((float(t_s.max()) - t0) / step_s)) + 1 if step_s > 0 else t_s.shape[0] + 1
-    if n_nodes > t_s.shape[0]:
-        return track.sensor_to_enu(points_sensor_m, t_s, mount)
-    node = np.rint((t_s - t0) / step_s).astype(np.intp)
-    node_t = t0 + step_s * np.arange(n_nodes)
+    starts = np.flatnonzero(np.r_[True, sweep[1:] != sweep[:-1]])  # each sweep's first point
+    count = np.diff(np.r_[starts, sweep.shape[0]])
+    t0 = np.minimum.reduceat(t_s, starts)
+    if step_s > 0:
+        n_nodes = np.ceil((np.maximum.reduceat(t_s, starts) - t0) / step_s).astype(np.int64) + 1
+        gridded = n_nodes <= count
+    else:
+        n_nodes, gridded = count + 1, np.zeros(starts.shape[0], dtype=bool)
+    n_nodes = np.where(gridded, n_nodes, count)  # a sweep off the grid: a node per point, at its time
+    node_start = np.cumsum(n_nodes) - n_nodes
+    segment = np.repeat(np.arange(starts.shape[0]), count)
+    own_time = ~gridded[segment]
+    node = np.where(own_time, np.arange(sweep.shape[0]) - starts[segment],
+                    np.rint((t_s - t0[segment]) / (step_s if step_s > 0 else 1.0)).astype(np.int64))
+    node_segment = np.repeat(np.arange(starts.shape[0]), n_nodes)
+    node_t = t0[node_segment] + step_s * (np.arange(node_segment.shape[0]) - node_start[node_segment])
+    node_t[~gridded[node_segment]] = t_s[own_time]
+    node += node_start[segment]
     rotation, translation, _ = _mount_pose(mount)
     body = points_sensor_m @ rotation.T + translation
     return np.einsum("nij,nj->ni", track.rotation(node_t)[node], body) + track.position_m(node_t)[node]

@@ -347,7 +347,7 @@ def test_connected_components_are_scipys_with_its_numbering(n, e):
     from scipy.sparse import csr_array
     from scipy.sparse.csgraph import connected_components
 
-    from tdm.frontend.lidar import _components
+    from tdm.frontend.lidar_graph import components as _components
 
     rng = np.random.default_rng(n + e)
     rows, cols = rng.integers(0, n, e), rng.integers(0, n, e)
@@ -368,3 +368,68 @@ def test_a_mount_pose_is_formed_once_and_is_the_mounts():
     assert np.array_equal(rotation, mount.rotation()) and np.array_equal(translation, mount.translation_m())
     assert not identity and _mount_pose(Mount(x_m=1.0))[2]
     assert not rotation.flags.writeable
+
+
+def _pickled(results) -> list[bytes]:
+    import pickle
+    return [pickle.dumps(r) for r in results]
+
+
+@pytest.mark.parametrize("config", [{}, {"deskew": False}, {"deskew_step_s": 0.0}, {"centre": "mean"}])
+def test_sweeps_taken_together_give_each_sweeps_result_alone(bos_recording, config):
+    """lidar_clusters_batch: each sweep's detections, point indices and labels, bit for bit, are those of the
+    sweep alone, whatever its neighbours in the batch (no point, all on the own ship, another dtype)."""
+    from tdm.frontend.lidar import lidar_clusters_batch
+    rec = Recording(bos_recording, **config)
+    sweeps = [s for k, s in enumerate(rec.sweeps()) if k % 7 == 0][:40]
+    own_ship = {k: v[sweeps[3]["object_id"] == 0] for k, v in sweeps[3].items()}
+    empty = {k: v[:0] for k, v in sweeps[5].items()}
+    wide = {**sweeps[8], **{k: sweeps[8][k].astype(np.float64) for k in ("x", "y", "z")}}
+    sweeps = sweeps[:4] + [own_ship, empty] + sweeps[4:9] + [wide] + sweeps[9:]
+    alone = [lidar_clusters(s, rec.track, rec.mount, rec.config) for s in sweeps]
+    assert sum(len(a[0]) for a in alone) > 50 and len(alone[4][0]) == len(alone[5][0]) == 0
+    for size in (5, 16, len(sweeps)):
+        together = [r for k in range(0, len(sweeps), size)
+                    for r in lidar_clusters_batch(sweeps[k:k + size], rec.track, rec.mount, rec.config)]
+        assert _pickled(together) == _pickled(alone)
+
+
+def test_voxel_pairs_are_the_kd_trees_pairs_within_each_sweep():
+    from scipy.spatial import cKDTree
+    from tdm.frontend.lidar_graph import voxel_grid, voxel_pairs
+    rng = np.random.default_rng(11)
+    for voxel_m, tolerance_m in ((0.25, 0.7), (0.3, 0.6), (0.5, 0.5), (0.2, 1.1)):
+        sweep = np.repeat(np.arange(4), 3000)
+        centres = rng.uniform(-20.0, 20.0, (40, 2))  # clumps of points, some sweeps sharing places
+        points = centres[rng.integers(0, 40, sweep.shape[0])] + rng.normal(0.0, 1.5, (sweep.shape[0], 2))
+        enu = np.column_stack([points, np.zeros(sweep.shape[0])])
+        grid = voxel_grid(enu, sweep, voxel_m, tolerance_m)
+        i, j = voxel_pairs(grid, tolerance_m)
+        voxel_sweep = np.zeros(grid.keys.shape[0], dtype=np.int64)
+        voxel_sweep[grid.inverse] = sweep
+        expected = set()
+        for s in range(4):
+            members = np.flatnonzero(voxel_sweep == s)
+            pairs = cKDTree(grid.centres_m[members]).query_pairs(tolerance_m, output_type="ndarray")
+            expected |= {tuple(p) for p in members[pairs]}
+        assert len(expected) > 1000 and {tuple(p) for p in np.column_stack([i, j])} == expected
+        assert np.all(i < j)
+
+
+def test_deskew_of_several_sweeps_with_a_pose_per_point_is_the_tracks():
+    """_deskewed with no grid is OwnshipTrack.sensor_to_enu bit for bit; with the grid, each point's pose is
+    at most half a step off its time."""
+    from tdm.frontend.lidar import _deskewed
+    t = np.linspace(0.0, 50.0, 6)
+    track = OwnshipTrack({"t": t, "lat": np.full(6, LAT0), "lon": LON0 + 1e-4 * t, "z": 0.1 * np.sin(t),
+                          "heading_deg": 7.0 * t, "roll_deg": 3.0 * np.sin(t), "pitch_deg": np.cos(t),
+                          "cog_deg": np.full(6, 90.0), "sog_mps": np.full(6, 0.2)})
+    mount = Mount(x_m=1.0, z_m=3.0, roll_deg=1.0)
+    rng = np.random.default_rng(2)
+    sweep = np.repeat(np.arange(3), [500, 7, 900])
+    times = np.sort(rng.uniform(0.0, 0.1, sweep.shape[0])) + 0.1 * sweep
+    points = rng.normal(0.0, 30.0, (sweep.shape[0], 3))
+    exact = track.sensor_to_enu(points, times, mount)
+    assert np.array_equal(_deskewed(track, points, times, sweep, mount, 0.0), exact)
+    gridded = _deskewed(track, points, times, sweep, mount, 2.5e-4)
+    assert np.abs(gridded - exact).max() < 0.01 and not np.array_equal(gridded, exact)
