@@ -3,6 +3,12 @@
 ``numpy.savez`` stamps each zip entry with the current time, so identical data
 would give different bytes; this writer fixes the stamp (same seed, same bytes)
 and writes atomically.
+
+The arrays' bytes go from their own memory into the archive: no ``.npy`` image is
+built in memory first, and an array given in pieces (a LiDAR revolution gathered
+from two chunks) is written piece after piece, never concatenated. The file is the
+one ``numpy.lib.format.write_array`` and ``ZipFile.writestr`` would give
+(``tests/raysim/test_recording_writers.py`` holds the two to it).
 """
 
 from __future__ import annotations
@@ -10,6 +16,7 @@ from __future__ import annotations
 import io
 import zipfile
 from pathlib import Path
+from typing import Mapping, Sequence
 
 import numpy as np
 
@@ -19,15 +26,43 @@ from raysim.recording.staging import atomic_path
 _EPOCH = (1980, 1, 1, 0, 0, 0)
 
 
-def write_npz(path: Path, arrays: dict[str, np.ndarray]) -> None:
-    """Write ``arrays`` (name -> array, in the given order) as an uncompressed .npz file."""
+def npy_header(dtype: np.dtype, shape: tuple[int, ...]) -> bytes:
+    """The ``.npy`` header (format 1.0, C order) of an array of this dtype and shape."""
+    buffer = io.BytesIO()
+    np.lib.format.write_array_header_1_0(
+        buffer, {"descr": np.lib.format.dtype_to_descr(np.dtype(dtype)), "fortran_order": False, "shape": tuple(shape)})
+    return buffer.getvalue()
+
+
+def write_npz_pieces(path: Path, pieces: Mapping[str, Sequence[np.ndarray]]) -> None:
+    """Write arrays given in pieces as an uncompressed .npz file, each the pieces' concatenation.
+
+    Parameters
+    ----------
+    path : Path
+        The file (written under a temporary name and renamed).
+    pieces : mapping of str to sequence of ndarray
+        Name -> one or more arrays of one dtype, equal in every dimension but the first
+        (concatenated along it), in the order the members are written.
+    """
     with atomic_path(Path(path)) as tmp, zipfile.ZipFile(tmp, "w", compression=zipfile.ZIP_STORED) as archive:
-        for name, array in arrays.items():
-            buffer = io.BytesIO()
-            np.lib.format.write_array(buffer, np.ascontiguousarray(array), allow_pickle=False)
+        for name, parts in pieces.items():
+            parts = [np.ascontiguousarray(p) for p in parts]  # (at least 1-d, as write_npz always wrote)
+            shape = (sum(p.shape[0] for p in parts),) + parts[0].shape[1:]
+            header = npy_header(parts[0].dtype, shape)
             info = zipfile.ZipInfo(f"{name}.npy", date_time=_EPOCH)
             info.external_attr = 0o644 << 16
-            archive.writestr(info, buffer.getvalue())
+            info.file_size = len(header) + sum(p.nbytes for p in parts)  # as writestr sets it
+            with archive.open(info, mode="w") as member:
+                member.write(header)
+                for part in parts:
+                    if part.nbytes:
+                        member.write(memoryview(part).cast("B"))
+
+
+def write_npz(path: Path, arrays: dict[str, np.ndarray]) -> None:
+    """Write ``arrays`` (name -> array, in the given order) as an uncompressed .npz file."""
+    write_npz_pieces(path, {name: [array] for name, array in arrays.items()})
 
 
 def write_sweep(sweeps_dir: Path, number: int, schema: SweepSchema, arrays: dict[str, np.ndarray]) -> None:
@@ -37,3 +72,16 @@ def write_sweep(sweeps_dir: Path, number: int, schema: SweepSchema, arrays: dict
     breach is a ``ValueError``, a writer's bug), the contract the TDM's readers check by.
     """
     write_npz(Path(sweeps_dir) / sweep_file_name(number), schema.conform(arrays))
+
+
+def write_sweep_pieces(sweeps_dir: Path, number: int, schema: SweepSchema,
+                       pieces: Mapping[str, Sequence[np.ndarray]]) -> None:
+    """:func:`write_sweep` of arrays given in pieces (:func:`write_npz_pieces`), never concatenated.
+
+    Each array's first piece is held to the contract (all pieces share its dtype and dimensions).
+    """
+    for name, parts in pieces.items():
+        if any(p.dtype != parts[0].dtype or p.shape[1:] != parts[0].shape[1:] for p in parts):
+            raise ValueError(f"{schema.sensor} sweep: the pieces of {name} differ in dtype or shape")
+    schema.conform({name: parts[0] for name, parts in pieces.items()})
+    write_npz_pieces(Path(sweeps_dir) / sweep_file_name(number), pieces)

@@ -12,7 +12,7 @@ import numpy as np
 
 from groundfloor import hdl32e
 from groundfloor.recording import LIDAR_SWEEP
-from raysim.recording.npz import write_sweep
+from raysim.recording.npz import write_sweep_pieces
 
 __all__ = ["LidarSweeps"]
 
@@ -42,15 +42,21 @@ class LidarSweeps:
         return np.floor((cfg.azimuth0_deg + DEG_PER_TURN * cfg.rotation_hz * t_s) / DEG_PER_TURN).astype(np.int64)
 
     def add(self, chunk) -> None:
-        """The points of one :class:`raysim.sensors.lidar.LidarChunk`; revolutions it completes are written."""
+        """The points of one :class:`raysim.sensors.lidar.LidarChunk`; revolutions it completes are written.
+
+        Points come in time order, so each revolution's points are one slice of the chunk's
+        arrays: views of them wait for the write, nothing is copied.
+        """
         revolution = self._revolution(chunk.time_s)
         pts, cycle_of_point = self.renderer.points(chunk.firings)
-        point_rev = revolution[cycle_of_point]
-        for rev in np.unique(revolution):
+        revs = np.unique(revolution)
+        # first point of each revolution of the chunk (its cycles are in time order, so are the points)
+        cut = np.searchsorted(np.take(revolution, cycle_of_point), revs, side="left").tolist() + [cycle_of_point.size]
+        for i, rev in enumerate(revs):
             if rev > self.current:
                 self._flush()
                 self.pending, self.current = [], int(rev)
-            self.pending.append({k: v[point_rev == rev] for k, v in pts.items()})
+            self.pending.append({k: v[cut[i]:cut[i + 1]] for k, v in pts.items()})
 
     def finish(self) -> None:
         """Write the last revolution if the render completed it."""
@@ -60,7 +66,7 @@ class LidarSweeps:
             self._flush()
 
     def _flush(self) -> None:
-        arrays = {k: np.concatenate([p[k] for p in self.pending]) for k in self.pending[0]}
-        write_sweep(self.sweeps_dir, self.current, LIDAR_SWEEP, arrays)
+        pieces = {k: [p[k] for p in self.pending] for k in self.pending[0]}
+        write_sweep_pieces(self.sweeps_dir, self.current, LIDAR_SWEEP, pieces)
         self.counts["sweeps"] += 1
-        self.counts["points"] += int(arrays["x"].shape[0])
+        self.counts["points"] += sum(int(p.shape[0]) for p in pieces["x"])
