@@ -182,25 +182,32 @@ class SeaClutter:
         table = self.mean_db_table(np.array([h_mid - CLUTTER_HEIGHT_STEP_M, h_mid + CLUTTER_HEIGHT_STEP_M]))
         slope = ((table[1] - table[0]) / (2.0 * CLUTTER_HEIGHT_STEP_M)).astype(np.float32)
         dh = (h_rows - h_mid).astype(np.float32)
-        mean_db = (table.mean(axis=0).astype(np.float32))[None, :] + dh[:, None] * slope[None, :]
+        # (R, N) float32 arrays formed in place (two buffers); each sum and product is the same float32 operation
+        mean_db = np.multiply(dh[:, None], slope[None, :])
+        mean_db += table.mean(axis=0).astype(np.float32)[None, :]
         psi, psi_c = self.grazing_deg(h_mid)
         psi_r = np.radians(psi_c).astype(np.float32)
         bh, sin_tilt, z_up = self._boresight(rot, azimuth_deg)
-        sin_el = np.cos(psi_r)[None, :] * sin_tilt[:, None] - np.sin(psi_r)[None, :] * z_up[:, None]
+        sin_el = np.multiply(np.cos(psi_r)[None, :], sin_tilt[:, None])
+        work = np.multiply(np.sin(psi_r)[None, :], z_up[:, None])
+        sin_el -= work
         # two-way Gaussian pattern in dB at the elevation asin(sin_el): ~ sin_el (0.5 % at 10 deg) except in the
         # first, steep range bins
         steep = int(np.count_nonzero(psi_c > STEEP_GRAZING_DEG))
-        el_sq = sin_el * sin_el
+        el_sq = np.multiply(sin_el, sin_el, out=work)
         el_sq[:, :steep] = np.arcsin(np.clip(sin_el[:, :steep], -1.0, 1.0)) ** 2
-        mean_db += np.float32(2.0 * phys.one_way_gain_db(math.degrees(1.0), self.p.beam_el_deg)) * el_sq
+        el_sq *= np.float32(2.0 * phys.one_way_gain_db(math.degrees(1.0), self.p.beam_el_deg))
+        mean_db += el_sq
         # wind direction (GIT): phi = 0 looking into the wind
         cos_up = (bh @ self.wind_from_en).astype(np.float32)
         gain_db, mean_gain_db = phys.git_wind_direction_db(psi_c, self.p.f_ghz)
-        mean_db += gain_db.astype(np.float32)[None, :] * cos_up[:, None] - mean_gain_db.astype(np.float32)[None, :]
+        wind_db = np.multiply(gain_db.astype(np.float32)[None, :], cos_up[:, None], out=work)
+        wind_db -= mean_gain_db.astype(np.float32)[None, :]
+        mean_db += wind_db
         # no sea is nearer than the antenna is high: there the grazing geometry has no solution and the table runs
         # away (278 dB at the antenna, 150 dB jumps per 0.1 m of height, overflowing float32 with the heave's slope;
         # an inf poisons the FTC filter down the whole spoke); the cap keeps the rest of float32 finite
-        mean_db[:, self.range_m <= h_max_m] = -np.inf
+        mean_db[:, : int(np.count_nonzero(self.range_m <= h_max_m))] = -np.inf  # range_m increases from 0
         np.minimum(mean_db, np.float32(MAX_CLUTTER_DB), out=mean_db)
         mean_db *= np.float32(math.log(10.0) / 10.0)  # 10^(x/10) as exp(x ln10/10): float32 exp is vectorised
         return np.exp(mean_db, out=mean_db), bh, cos_up, psi_c
@@ -224,14 +231,14 @@ class SeaClutter:
         time_s : float
             Time of the revolution's texture, s.
         """
-        rng32 = self.range_m[None, :]
-        east = pos[:, 0, None].astype(np.float32) + bh[:, 0, None].astype(np.float32) * rng32
-        north = pos[:, 1, None].astype(np.float32) + bh[:, 1, None].astype(np.float32) * rng32
-        z = self.texture_field.sample(east, north, time_s)
+        # the cells range by range (N, R): the moving average over azimuth below runs along memory
+        rng32 = self.range_m[:, None]
+        east = pos[None, :, 0].astype(np.float32) + bh[None, :, 0].astype(np.float32) * rng32
+        north = pos[None, :, 1].astype(np.float32) + bh[None, :, 1].astype(np.float32) * rng32
+        zt = self.texture_field.sample(east, north, time_s)
         # two passes of a moving average over one beamwidth (circular in azimuth; on the transposed, contiguous
         # array), then unit variance again at each range: the marginal is standard normal again
         width = max(1, int(round(self.beam_spokes / self.sub)))
-        zt = np.ascontiguousarray(z.T)
         zt = uniform_filter1d(uniform_filter1d(zt, width, axis=1, mode="wrap"), width, axis=1, mode="wrap")
         std = np.maximum(uniform_filter1d(zt.std(axis=1), TEXTURE_STD_WINDOW_BINS, mode="nearest"), 1e-6)
         z = np.ascontiguousarray((zt / std[:, None]).T)
@@ -280,10 +287,14 @@ class SeaClutter:
         if self.sea_state > 0:
             texture = self.texture_rows(pos[rows], bh, cos_up, psi_c, float(t[S // 2]))
             mean *= texture
-        clutter = np.repeat(mean, self.sub, axis=0) if self.sub > 1 else mean
-        if speckle is not None:
+        if speckle is not None and self.sub > 1:  # each formed spoke's mean times the speckle of its sub spokes
+            clutter = np.multiply(mean[:, None, :], speckle.reshape(S // self.sub, self.sub, N)).reshape(S, N)
+        elif speckle is not None:
+            clutter = mean
             clutter *= speckle
-        elif texture is not None:
+        else:
+            clutter = np.repeat(mean, self.sub, axis=0) if self.sub > 1 else mean
+        if speckle is None and texture is not None:
             clutter *= stream(self.seed, f"radar.clutter.{rev}").standard_exponential((S, N), dtype=np.float32)
         if first_hit_m is not None:
             self.shadow(clutter, first_hit_m)

@@ -192,9 +192,54 @@ class GammaQuantiles:
         self.table = (gammaincinv(nu, u) / nu).astype(np.float64)
         self.dz = self.z[1] - self.z[0]
         self._table32 = self.table.reshape(-1).astype(np.float32)
+        # each entry with its step to the next, (lo, hi - lo) as one complex64: one gather reads both (the step is
+        # the float32 difference the interpolation forms, so the same values; the last step is never read)
+        pairs = np.zeros((self._table32.size, 2), np.float32)
+        pairs[:, 0] = self._table32
+        pairs[:-1, 1] = self._table32[1:] - self._table32[:-1]
+        self._pairs = pairs.view(np.complex64).reshape(-1)
 
     def __call__(self, z: np.ndarray, log_nu: np.ndarray) -> np.ndarray:
-        """Gamma(nu, mean 1) quantiles (float32) of standard-normal ``z``; ``log_nu`` is ln(shape), broadcastable."""
+        """Gamma(nu, mean 1) quantiles of standard-normal ``z``; ``log_nu`` is ln(shape), broadcastable.
+
+        The values of :meth:`reference` (the same operations in the same precisions), with fewer passes: one gather
+        of (entry, step) pairs and the arithmetic in place.
+
+        Parameters
+        ----------
+        z : (...) float
+            Standard-normal values (cast to float32).
+        log_nu : (...) float32
+            Natural log of the K shape of each value.
+
+        Returns
+        -------
+        (...) float64
+            Quantiles (the interpolation's weights are float64).
+        """
+        z = np.asarray(z, dtype=np.float32)
+        step = np.float32(self.log_nu[1] - self.log_nu[0])
+        row = np.clip(log_nu, self.log_nu[0], self.log_nu[-1])  # float64 (float64 bounds), as in the reference
+        row -= np.float32(self.log_nu[0])
+        row /= step
+        np.rint(row, out=row)
+        flat = row.astype(np.intp)
+        flat *= self.z.size
+        pos = z - np.float32(self.z[0])
+        pos *= np.float32(1.0 / self.dz)
+        np.clip(pos, 0.0, np.float32(self.z.size - 1.001), out=pos)
+        j = pos.astype(np.int32)
+        flat = np.add(flat, j, out=flat if flat.shape == j.shape else None)
+        frac = pos - j  # float32 - int32: float64, as in the reference
+        pair = self._pairs.take(flat)
+        if frac.shape != pair.shape:  # log_nu broader than z
+            frac = np.broadcast_to(frac, pair.shape).copy()
+        frac *= pair.imag  # the reference's (hi - lo) * frac
+        frac += pair.real
+        return frac
+
+    def reference(self, z: np.ndarray, log_nu: np.ndarray) -> np.ndarray:
+        """:meth:`__call__` written plainly (kept for the tests: the fast form must give these bytes)."""
         z = np.asarray(z, dtype=np.float32)
         step = np.float32(self.log_nu[1] - self.log_nu[0])
         k = np.rint((np.clip(log_nu, self.log_nu[0], self.log_nu[-1]) - np.float32(self.log_nu[0])) / step).astype(np.int32)

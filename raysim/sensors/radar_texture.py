@@ -90,8 +90,11 @@ class SeaTexture:
             if len(self._keys) >= KEY_FRAMES_KEPT:
                 self._keys.pop(min(self._keys))
             white = stream(self.seed, f"radar.texture.{k}").standard_normal((self.n, self.n), dtype=np.float32)
-            field = scipy.fft.irfft2(scipy.fft.rfft2(white) * self._transfer, s=(self.n, self.n))
-            self._keys[k] = (field / field.std()).astype(np.float32).reshape(-1)
+            spectrum = scipy.fft.rfft2(white)  # complex64
+            spectrum *= self._transfer
+            field = scipy.fft.irfft2(spectrum, s=(self.n, self.n), overwrite_x=True)  # float32
+            field /= field.std()
+            self._keys[k] = field.reshape(-1)
         return self._keys[k]
 
     def sample(self, east_m: np.ndarray, north_m: np.ndarray, time_s: float) -> np.ndarray:
@@ -113,10 +116,31 @@ class SeaTexture:
         frac = u - k
         shift = self.drift_mps * time_s * self.down_wind
         mask = self.n - 1  # the tile repeats: index modulo n (a power of two) by masking
-        i = np.floor((east_m - shift[0]) * (1.0 / self.cell_m)).astype(np.int64) & mask
-        j = np.floor((north_m - shift[1]) * (1.0 / self.cell_m)).astype(np.int64) & mask
-        flat = i * self.n + j
+        flat = self._cell_index(east_m, shift[0], mask)
+        flat *= self.n
+        flat += self._cell_index(north_m, shift[1], mask)
         a = self._key(k).take(flat)
         b = self._key(k + 1).take(flat)
-        ca, cb = math.cos(0.5 * math.pi * frac), math.sin(0.5 * math.pi * frac)
-        return (ca * a + cb * b).astype(np.float32, copy=False)
+        a *= math.cos(0.5 * math.pi * frac)  # float32 (a Python float scalar keeps the array's precision)
+        b *= math.sin(0.5 * math.pi * frac)
+        a += b
+        return a
+
+    def _cell_index(self, coordinate_m: np.ndarray, shift_m: np.float64, mask: int) -> np.ndarray:
+        """(...) int64 tile cell of each coordinate along one axis: ``floor((x - shift) / cell) & mask``, in float64.
+
+        Parameters
+        ----------
+        coordinate_m : (...) float
+            East or north of each point, m.
+        shift_m : numpy.float64
+            The tile's drift along that axis, m (a float64 scalar: the difference is formed in float64).
+        mask : int
+            ``n - 1``: the index modulo the tile size.
+        """
+        x = np.subtract(coordinate_m, shift_m, dtype=np.float64)
+        x *= 1.0 / self.cell_m
+        np.floor(x, out=x)
+        index = x.astype(np.int64)
+        index &= mask
+        return index
