@@ -76,23 +76,9 @@ def _ip_checksum(header: np.ndarray) -> np.ndarray:
     return (~total & 0xFFFF).astype(np.uint16)
 
 
-def udp_frames(payloads: np.ndarray, port: int, ip_id_start: int) -> np.ndarray:
-    """Ethernet II / IPv4 / UDP frames around equal-sized payloads.
-
-    Parameters
-    ----------
-    payloads : (N, L) uint8
-    port : int
-        Source and destination UDP port.
-    ip_id_start : int
-        IPv4 identification of the first frame (then counting up, modulo 2^16).
-
-    Returns
-    -------
-    (N, 42 + L) uint8
-    """
-    n, length = payloads.shape
-    frames = np.empty((n, 42 + length), dtype=np.uint8)
+def _fill_udp_headers(frames: np.ndarray, length: int, port: int, ip_id_start: int) -> None:
+    """The 42 bytes of Ethernet II, IPv4 and UDP header in ``frames[:, :42]`` ((N, >= 42) uint8, written in place)."""
+    n = frames.shape[0]
     frames[:, 0:6] = np.frombuffer(BROADCAST_MAC, np.uint8)
     frames[:, 6:12] = np.frombuffer(SENSOR_MAC, np.uint8)
     frames[:, 12:14] = (0x08, 0x00)
@@ -117,8 +103,40 @@ def udp_frames(payloads: np.ndarray, port: int, ip_id_start: int) -> np.ndarray:
     udp_length = 8 + length
     frames[:, 38:40] = (udp_length >> 8, udp_length & 0xFF)
     frames[:, 40:42] = 0  # UDP checksum optional over IPv4
+
+
+def udp_frames(payloads: np.ndarray, port: int, ip_id_start: int) -> np.ndarray:
+    """Ethernet II / IPv4 / UDP frames around equal-sized payloads.
+
+    Parameters
+    ----------
+    payloads : (N, L) uint8
+    port : int
+        Source and destination UDP port.
+    ip_id_start : int
+        IPv4 identification of the first frame (then counting up, modulo 2^16).
+
+    Returns
+    -------
+    (N, 42 + L) uint8
+    """
+    n, length = payloads.shape
+    frames = np.empty((n, 42 + length), dtype=np.uint8)
+    _fill_udp_headers(frames, length, port, ip_id_start)
     frames[:, 42:] = payloads
     return frames
+
+
+def _fill_record_headers(records: np.ndarray, length: int, unix_time_s: np.ndarray) -> None:
+    """The 16-byte PCAP record headers in ``records[:, :16]`` ((N, >= 16) uint8): seconds, microseconds, lengths."""
+    n = records.shape[0]
+    usec_total = np.round(np.asarray(unix_time_s, dtype=np.float64) * 1e6).astype(np.int64)
+    header = np.empty((n, 4), dtype="<u4")
+    header[:, 0] = usec_total // 1_000_000
+    header[:, 1] = usec_total % 1_000_000
+    header[:, 2] = length
+    header[:, 3] = length
+    records[:, :16] = header.view(np.uint8).reshape(n, 16)
 
 
 class PcapWriter:
@@ -137,22 +155,23 @@ class PcapWriter:
         n, length = frames.shape
         if n == 0:
             return
-        usec_total = np.round(np.asarray(unix_time_s, dtype=np.float64) * 1e6).astype(np.int64)
         records = np.empty((n, 16 + length), dtype=np.uint8)
-        header = np.empty((n, 4), dtype="<u4")
-        header[:, 0] = usec_total // 1_000_000
-        header[:, 1] = usec_total % 1_000_000
-        header[:, 2] = length
-        header[:, 3] = length
-        records[:, :16] = header.view(np.uint8).reshape(n, 16)
+        _fill_record_headers(records, length, unix_time_s)
         records[:, 16:] = frames
-        self.handle.write(records.tobytes())
+        self.handle.write(records.data)  # the buffer itself, no bytes copy
         self.frames += n
 
     def write_udp(self, payloads: np.ndarray, port: int, unix_time_s: np.ndarray) -> None:
-        """Wrap (N, L) payloads in UDP frames and append them."""
-        self.write(udp_frames(payloads, port, self._ip_id), unix_time_s)
-        self._ip_id = (self._ip_id + payloads.shape[0]) & 0xFFFF
+        """Wrap (N, L) payloads in UDP frames and append them (one buffer: record headers, frame headers, payloads)."""
+        n, length = payloads.shape
+        if n:
+            records = np.empty((n, 16 + 42 + length), dtype=np.uint8)
+            _fill_record_headers(records, 42 + length, unix_time_s)
+            _fill_udp_headers(records[:, 16:], length, port, self._ip_id)
+            records[:, 16 + 42:] = payloads
+            self.handle.write(records.data)
+            self.frames += n
+        self._ip_id = (self._ip_id + n) & 0xFFFF
 
 
 __all__ = ["PACKET_DTYPE", "encode_data_packets", "encode_position_packet", "udp_frames", "PcapWriter",
