@@ -155,16 +155,26 @@ def _read_exactly(fp, n: int) -> bytes:
     return data
 
 
-def _parse_header(fp, info: zipfile.ZipInfo, path: Path) -> ArrayHeader:
+def _parse_header(fp, info: zipfile.ZipInfo | StoredMember, path: Path) -> ArrayHeader:
     """The header of a member opened at its start (``fp`` is left at the array's data)."""
-    name = info.filename[:-4]
     prefix = _read_exactly(fp, 10)  # magic (6), version (2), header length (2 in version 1.0, else 4)
     if prefix[6] != 1:
         prefix += _read_exactly(fp, 2)
+    length = _header_length(prefix, info)
+    return _checked_header(prefix + _read_exactly(fp, length), info, path)
+
+
+def _header_length(prefix: bytes, info: zipfile.ZipInfo | StoredMember) -> int:
+    """The header text's length, from the 10 or 12 bytes before it (refused beyond :data:`MAX_HEADER_BYTES`)."""
     length = int.from_bytes(prefix[8:], "little")
     if length > MAX_HEADER_BYTES:
-        raise Unreadable(DAMAGED, f"array {name!r}: a .npy header of {length} bytes")
-    raw = prefix + _read_exactly(fp, length)
+        raise Unreadable(DAMAGED, f"array {info.filename[:-4]!r}: a .npy header of {length} bytes")
+    return length
+
+
+def _checked_header(raw: bytes, info: zipfile.ZipInfo | StoredMember, path: Path) -> ArrayHeader:
+    """The header ``raw`` (magic to the end of the header text) decoded and checked against the archive."""
+    name = info.filename[:-4]
     decoded = _decode_header(raw)
     if len(decoded) == 2:
         raise RecordingError(str(path), name, f".npy format version {decoded} not supported (1.0, 2.0)")
@@ -180,6 +190,32 @@ def _parse_header(fp, info: zipfile.ZipInfo, path: Path) -> ArrayHeader:
         raise RecordingError(str(path), name, f"shape {header.shape} of {header.nbytes} bytes, more than the "
                                               f"{MAX_ARRAY_BYTES} an array of a sweep may hold")
     return header
+
+
+def _stored_member(data: bytes, info: StoredMember, path: Path, load: bool) -> tuple[ArrayHeader, np.ndarray | None]:
+    """A stored member's header, and its array when ``load`` (its CRC-32 checked first, as
+    :func:`_read_member` does), sliced from the archive's bytes: what :func:`_member_header` and
+    :func:`_read_member` give, without a stream over the member."""
+    start, end = info.data_start, info.data_start + info.file_size
+    try:
+        if load and zlib.crc32(memoryview(data)[start:end]) != info.CRC:
+            raise zipfile.BadZipFile(f"bad CRC-32 for {info.filename}")
+        prefix = data[start:min(start + 12, end)]
+        head = 10 if len(prefix) >= 10 and prefix[6] == 1 else 12
+        if len(prefix) < head:
+            raise EOFError("member ends inside its .npy header")
+        length = _header_length(prefix[:head], info)
+        if start + head + length > end:
+            raise EOFError("member ends inside its .npy header")
+    except _ZIP_ERRORS:
+        raise Unreadable(DAMAGED, f"array {info.filename[:-4]!r}") from None
+    header = _checked_header(data[start:start + head + length], info, path)
+    if not load:
+        return header, None
+    flat = np.frombuffer(data, dtype=header.dtype, count=math.prod(header.shape), offset=start + head + length).copy()
+    if header.fortran_order:
+        return header, flat.reshape(header.shape[::-1]).transpose()
+    return header, flat.reshape(header.shape)
 
 
 def _member_header(zf: zipfile.ZipFile | None, info: zipfile.ZipInfo | StoredMember, path: Path,
@@ -251,7 +287,11 @@ class NpzFile:
             self._infos = {info.filename[:-4]: info for info in infos if info.filename.endswith(".npy")}
             self.layout = {}
             for name, info in self._infos.items():
-                if name in preload:
+                if members is not None:  # a plain stored archive in memory
+                    self.layout[name], array = _stored_member(self._data, info, self.path, name in preload)
+                    if array is not None:
+                        self._loaded[name] = array
+                elif name in preload:
                     self.layout[name], self._loaded[name] = _read_member(self._zf, info, self.path, self._data)
                 else:
                     self.layout[name] = _member_header(self._zf, info, self.path, self._data)

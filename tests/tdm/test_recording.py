@@ -47,8 +47,15 @@ def test_arrays_read_as_np_load_reads_them(tmp_path):
         assert read_layout(tmp_path / name)["a"].shape == (3, 4)
 
 
+def _load(path, names, preload: bool) -> dict:
+    """The arrays ``names``, read with the headers (``preload``, as read_sweep reads) or after them."""
+    with NpzFile(path, preload=names if preload else ()) as npz:
+        return npz.load(names)
+
+
+@pytest.mark.parametrize("preload", [True, False])
 @pytest.mark.parametrize("in_memory", [True, False])
-def test_both_reading_routes_give_np_load_arrays(tmp_path, monkeypatch, in_memory):
+def test_both_reading_routes_give_np_load_arrays(tmp_path, monkeypatch, in_memory, preload):
     """Small files are read whole and their stored members sliced out; larger ones go through zipfile."""
     if not in_memory:
         monkeypatch.setattr(npz_module, "IN_MEMORY_MAX_BYTES", 0)
@@ -57,7 +64,7 @@ def test_both_reading_routes_give_np_load_arrays(tmp_path, monkeypatch, in_memor
               "s": np.float64(3.5), "t": np.array(["2026-11-27"], dtype="datetime64[ns]"),
               "r": np.zeros(3, dtype=[("a", "<i4"), ("b", "<f8")])}
     np.savez(tmp_path / "a.npz", **arrays)
-    got = load_arrays(tmp_path / "a.npz", tuple(arrays))
+    got = _load(tmp_path / "a.npz", tuple(arrays), preload)
     with np.load(tmp_path / "a.npz") as want:
         for key in arrays:
             assert got[key].dtype == want[key].dtype and got[key].shape == want[key].shape, key
@@ -82,9 +89,10 @@ def _central_directory_entry(content: bytes, name: bytes) -> int:
     return at
 
 
+@pytest.mark.parametrize("preload", [True, False])
 @pytest.mark.parametrize("in_memory", [True, False])
-@pytest.mark.parametrize("fault", ["data", "crc", "local header"])
-def test_a_damaged_stored_member_is_unreadable_on_both_routes(tmp_path, monkeypatch, in_memory, fault):
+@pytest.mark.parametrize("fault", ["data", "crc", "local header", "header cut"])
+def test_a_damaged_stored_member_is_unreadable_on_both_routes(tmp_path, monkeypatch, in_memory, fault, preload):
     if not in_memory:
         monkeypatch.setattr(npz_module, "IN_MEMORY_MAX_BYTES", 0)
     np.savez(tmp_path / "a.npz", y=np.arange(3), x=np.arange(1000, dtype=np.float64))  # x not at the start
@@ -95,11 +103,14 @@ def test_a_damaged_stored_member_is_unreadable_on_both_routes(tmp_path, monkeypa
         content[x_at + 2000] ^= 0xFF
     elif fault == "crc":  # the central directory's CRC-32 of x changed
         content[_central_directory_entry(bytes(content), b"x.npy") + 16] ^= 0xFF
-    else:  # x's local header overwritten
+    elif fault == "local header":  # x's local header overwritten
         content[x_at:x_at + 4] = b"\0\0\0\0"
+    else:  # x's .npy header says its text is longer than the member
+        x_data = x_at + 30 + len("x.npy") + int.from_bytes(content[x_at + 28:x_at + 30], "little")  # + extra field
+        content[x_data + 8:x_data + 10] = (60000).to_bytes(2, "little")
     (tmp_path / "b.npz").write_bytes(bytes(content))
     with pytest.raises(Unreadable) as caught:
-        load_arrays(tmp_path / "b.npz", ("x", "y"))
+        _load(tmp_path / "b.npz", ("x", "y"), preload)
     assert caught.value.reason == "damaged array data" and "'x'" in caught.value.detail
 
 
