@@ -367,7 +367,8 @@ class LidarRenderer:
             reflectance[on_sea] = 0.0  # calm water: a specular mirror, nothing comes back
             source[on_sea] = SOURCE_SEA
             # foam is looked up only where a foam echo could be detected at all
-            could = np.flatnonzero(sea & (phys.echo_power(FOAM_REFLECTANCE * cos_h, r_h, self.alpha) >= self.threshold))
+            foam_power = phys.echo_power(FOAM_REFLECTANCE * np.take(cos_h, on_sea), np.take(r_h, on_sea), self.alpha)
+            could = np.take(on_sea, np.flatnonzero(foam_power >= self.threshold))
             if could.size:
                 rays_c = np.take(h, could)
                 r_c = np.take(r_h, could)

@@ -65,6 +65,8 @@ def detection_threshold(detection_reflectance: float) -> float:
 def reflectivity_byte(reflectance: np.ndarray, cos_incidence: np.ndarray, retro: np.ndarray) -> np.ndarray:
     """HDL-32E calibrated reflectivity byte (uint8) per echo."""
     diffuse = np.clip(np.round(100.0 * reflectance * cos_incidence), 1, 100)
+    if not np.any(retro):  # (the usual case: the retro-reflective values would all be discarded)
+        return np.broadcast_to(diffuse, np.broadcast_shapes(np.shape(diffuse), np.shape(retro))).astype(np.uint8)
     retro_value = 101 + np.round(154.0 * np.clip(cos_incidence, 0.0, 1.0))
     return np.where(retro, retro_value, diffuse).astype(np.uint8)
 

@@ -245,3 +245,15 @@ def test_measure_and_points_are_the_reference_bit_for_bit(scenario_file, changes
     assert list(points) == list(ref_points) and cycles.tobytes() == ref_cycles.tobytes()
     for name, value in points.items():
         assert value.dtype == ref_points[name].dtype and value.tobytes() == ref_points[name].tobytes(), name
+
+
+def test_reflectivity_byte_without_retro_reflectors_is_the_full_formula():
+    from raysim.sensors import lidar_physics as phys
+
+    rng = np.random.default_rng(6)
+    reflectance, cos = rng.random(5000), rng.uniform(-0.1, 1.1, 5000)
+    for retro in (np.zeros(5000, bool), rng.random(5000) < 0.3):
+        diffuse = np.clip(np.round(100.0 * reflectance * cos), 1, 100)
+        full = np.where(retro, 101 + np.round(154.0 * np.clip(cos, 0.0, 1.0)), diffuse).astype(np.uint8)
+        fast = phys.reflectivity_byte(reflectance, cos, retro)
+        assert fast.dtype == np.uint8 and fast.tobytes() == full.tobytes()
