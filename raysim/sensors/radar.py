@@ -336,82 +336,98 @@ class RadarRenderer:
     def revolution(self, rev: int) -> Revolution:
         """Render revolution ``rev`` (deterministic: its random streams are named after it).
 
-        The sea clutter and the receiver noise (numpy work that releases the GIL) are formed on a second thread
-        while this one casts the rays and forms the object echoes; the shadow of the objects is cut into the
-        clutter once both are done. Every random draw comes from a stream named after its job and the revolution,
-        so the bytes do not depend on the threads' timing.
+        The sea clutter with the receiver noise, and the rain (numpy work that releases the GIL), are formed on two
+        more threads while this one casts the rays and forms the object echoes; the shadow of the objects is cut
+        into the clutter once all are done (:meth:`_video`). Every random draw comes from a stream named after its
+        job and the revolution, so the bytes do not depend on the threads' timing.
         """
         K = self.k
         t, azimuth, poses, rot, pos, o_w, d_w = self.rays(rev)
         heading = heading_deg_from_yaw(poses.yaw_rad)
         antenna_h = np.maximum(pos[:, 2], CLUTTER_MIN_HEIGHT_M)
         max_range = self.max_range_m
-        with ThreadPoolExecutor(max_workers=1, thread_name_prefix="radar-clutter") as pool:
+        with ThreadPoolExecutor(max_workers=2, thread_name_prefix="radar-clutter") as pool:
             sea = pool.submit(self._sea_and_noise, rev, t, rot, pos, azimuth, heading, antenna_h)
+            rain = pool.submit(self.rain.revolution, self.seed, rev, t, pos, heading + azimuth)
             hits, on_carrier = self.scene.cast(o_w, d_w, np.repeat(t, K), max_range_m=max_range,
                                                carrier_hits=self.own_hits)
             targets, first_hit, seen = self.targets.render(hits, on_carrier, t, o_w, d_w, antenna_h, rot, azimuth,
                                                            max_range)
             clutter, texture, noise = sea.result()
-        self.sea_clutter.shadow(clutter, first_hit)
+            rain_loss, rain_clutter = rain.result()
 
         # ---- receiver: rain clutter, attenuation, thermal noise, STC, FTC, log video, fixed 4-bit levels
-        # one fresh (S, N) array, worked in place from here (the clutter and target arrays are returned as they are)
-        total = clutter + targets if targets is not None else clutter.copy()
-        rain_loss, rain_clutter = self.rain.revolution(self.seed, rev, t, pos, heading + azimuth)
-        if rain_clutter is not None:
-            total += rain_clutter
-        if rain_loss is not None:
-            total *= rain_loss
-        if self.interference.active:
+        def interference(total: np.ndarray) -> None:
             self.interference.add_to(total, t, pos, heading + azimuth)
-        p_db, levels = self._video(total, noise)
+
+        echoes = _Echoes(clutter, targets, first_hit, rain_loss, rain_clutter)
+        p_db, levels = self._video(echoes, noise, interference if self.interference.active else None)
         echo = reject(levels, self.cfg.interference_rejection)
         echo[:, : self.blank] = 0
         return Revolution(echo, azimuth.astype(np.float32), heading.astype(np.float32), t, self.range_m,
                           snr_db=p_db, first_hit_m=first_hit, target_snr=targets, texture_rows=texture, clutter=clutter,
                           object_id=seen[0], object_spokes=seen[1], texture_sub=self.sea_clutter.sub)
 
-    def _video(self, total: np.ndarray, noise: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Receiver from the echo power to the 4-bit video, in place, on two halves of the spokes in two threads.
+    def _video(self, echoes: "_Echoes", noise: np.ndarray, interference=None) -> tuple[np.ndarray, np.ndarray]:
+        """Receiver from the echoes to the 4-bit video, on two halves of the spokes in two threads.
 
-        Noise, STC, saturation, log video, FTC and the fixed levels act spoke by spoke (the FTC along range), so
-        the halves are independent.
+        Per spoke: the shadow cut into the sea clutter, the echo power ``((clutter + targets) + rain) x rain loss``,
+        then noise, STC, saturation, log video, FTC (along range) and the fixed levels; so the halves are independent.
+        Other radars' pulses (``interference``) are added to the whole revolution between the two stages.
 
         Parameters
         ----------
-        total : (S, N) float32
-            Echo power (SNR, linear) of the revolution without the noise; becomes the log video, dB re. noise.
+        echoes : _Echoes
+            The revolution's echoes; its sea clutter gets the shadow, in place.
         noise : (S, N) float32
             Thermal noise power (exponential, mean 1).
+        interference : callable, optional
+            Adds other radars' pulses to the (S, N) echo power in place.
 
         Returns
         -------
         p_db : (S, N) float32
-            ``total``: the power over the noise, dB, after STC, saturation and FTC.
+            The power over the noise, dB, after STC, saturation and FTC.
         levels : (S, N) uint8
             Video levels 0..15.
         """
+        total = np.empty_like(echoes.clutter)
+        halves = (slice(0, self.spokes // 2), slice(self.spokes // 2, None))
+        if interference is None:
+            def both(rows: slice) -> np.ndarray:
+                echoes.power(rows, total[rows], self.sea_clutter)
+                return self._receive(total[rows], noise[rows])
+
+            return total, np.concatenate(_on_two_threads(both, halves))
+        _on_two_threads(lambda rows: echoes.power(rows, total[rows], self.sea_clutter), halves)
+        interference(total)
+        return total, np.concatenate(_on_two_threads(lambda rows: self._receive(total[rows], noise[rows]), halves))
+
+    def _receive(self, block: np.ndarray, noise: np.ndarray) -> np.ndarray:
+        """Noise, STC, saturation, log video, FTC and the fixed 4-bit levels of (M, N) spokes, in place.
+
+        Parameters
+        ----------
+        block : (M, N) float32
+            Echo power (SNR, linear) without the noise; becomes the log video, dB re. noise.
+        noise : (M, N) float32
+            Thermal noise power (exponential, mean 1).
+
+        Returns
+        -------
+        (M, N) uint8
+            Video levels 0..15.
+        """
         p = self.p
-
-        def halve(rows: slice) -> np.ndarray:
-            block = total[rows]
-            block += noise[rows]
-            block *= self.stc_lin[None, :]
-            radar_receiver.saturate(block, self.receiver.saturation_db, out=block)
-            # 10 log10 P as (10 / ln 10) ln P: numpy's float32 log is vectorised, its log10 is not (3x slower)
-            np.log(np.maximum(block, np.float32(POWER_FLOOR), out=block), out=block)
-            block *= np.float32(10.0 / math.log(10.0))
-            if p.ftc_m > 0:
-                block[...] = self._ftc(block)
-            return phys.quantise(block, p.video_floor_db, p.video_step_db)
-
-        half = slice(self.spokes // 2, None)
-        with ThreadPoolExecutor(max_workers=1, thread_name_prefix="radar-video") as pool:
-            second = pool.submit(halve, half)
-            first = halve(slice(0, self.spokes // 2))
-            levels = np.concatenate([first, second.result()])
-        return total, levels
+        block += noise
+        block *= self.stc_lin[None, :]
+        radar_receiver.saturate(block, self.receiver.saturation_db, out=block)
+        # 10 log10 P as (10 / ln 10) ln P: numpy's float32 log is vectorised, its log10 is not (3x slower)
+        np.log(np.maximum(block, np.float32(POWER_FLOOR), out=block), out=block)
+        block *= np.float32(10.0 / math.log(10.0))
+        if p.ftc_m > 0:
+            block[...] = self._ftc(block)
+        return phys.quantise(block, p.video_floor_db, p.video_step_db)
 
     def _sea_and_noise(self, rev, t, rot, pos, azimuth, heading, antenna_h):
         """The revolution's sea clutter without shadow, its texture and the (S, N) thermal noise.
@@ -477,6 +493,39 @@ class RadarRenderer:
             if pending is not None:
                 pending.result()
         return counts
+
+
+@dataclass
+class _Echoes:
+    """A revolution's echoes before the receiver: (S, N) float32 SNR arrays, linear re. noise."""
+
+    clutter: np.ndarray  # (S, N) sea clutter without the shadow
+    targets: np.ndarray | None  # (S, N) object echoes, or None
+    first_hit_m: np.ndarray  # (S,) first object hit per spoke, m (inf: none)
+    rain_loss: np.ndarray | None  # (S, N) or (1, N) two-way rain attenuation (a factor), or None
+    rain_clutter: np.ndarray | None  # (S, N) rain echoes, or None
+
+    def power(self, rows: slice, out: np.ndarray, sea: SeaClutter) -> None:
+        """Cut the shadow into the clutter of the spokes ``rows`` and write their ``((clutter + targets) + rain) x
+        rain loss`` into ``out`` (M, N), the order of the sums of the whole-revolution form."""
+        clutter = self.clutter[rows]
+        sea.shadow(clutter, self.first_hit_m[rows])
+        if self.targets is not None:
+            np.add(clutter, self.targets[rows], out=out)
+        else:
+            out[...] = clutter
+        if self.rain_clutter is not None:
+            out += self.rain_clutter[rows]
+        if self.rain_loss is not None:
+            out *= self.rain_loss[rows] if self.rain_loss.shape[0] > 1 else self.rain_loss
+
+
+def _on_two_threads(work, halves: tuple[slice, slice]) -> list:
+    """``[work(halves[0]), work(halves[1])]``, the second half on a thread of its own."""
+    with ThreadPoolExecutor(max_workers=1, thread_name_prefix="radar-video") as pool:
+        second = pool.submit(work, halves[1])
+        first = work(halves[0])
+        return [first, second.result()]
 
 
 def render_radar(ctx: SensorContext) -> None:

@@ -194,3 +194,41 @@ def test_sea_clutter_mean_texture_and_speckle_equal_the_plain_forms():
     unit, _ = c.render(0, t, rot, pos, azimuth, azimuth, height, None, np.ones_like(speckle))
     assert np.array_equal(unit, np.repeat((mean * texture).astype(np.float32), c.sub, axis=0))
     assert np.array_equal(clutter, unit * speckle)
+
+
+# ------------------------------------------------------------------ receiver: halves on two threads
+
+@pytest.mark.parametrize("with_targets, with_rain, with_interference", [(True, False, False), (False, True, True),
+                                                                        (True, True, False), (True, False, True)])
+def test_video_in_halves_equals_the_whole_revolution_form(radar, with_targets, with_rain, with_interference):
+    from raysim.sensors.radar import _Echoes
+
+    rng = np.random.default_rng(9)
+    shape = (SPOKES, SAMPLES)
+    clutter = rng.standard_exponential(shape, dtype=np.float32) * np.float32(30.0)
+    targets = rng.standard_exponential(shape, dtype=np.float32) ** 4 if with_targets else None
+    first_hit = np.where(rng.random(SPOKES) < 0.3, rng.uniform(50.0, 500.0, SPOKES), np.inf)
+    rain_loss = rng.uniform(0.5, 1.0, (1, SAMPLES)).astype(np.float32) if with_rain else None
+    rain_clutter = rng.standard_exponential(shape, dtype=np.float32) if with_rain else None
+    noise = rng.standard_exponential(shape, dtype=np.float32)
+    pulses = (rng.random(shape) < 1e-3).astype(np.float32) * np.float32(1e5)
+
+    def interference(total):
+        total += pulses
+
+    # the whole-revolution form: shadow, sum, rain, interference, then the receiver on all spokes at once
+    plain_clutter = clutter.copy()
+    radar.sea_clutter.shadow(plain_clutter, first_hit)
+    total = plain_clutter + targets if targets is not None else plain_clutter.copy()
+    if with_rain:
+        total += rain_clutter
+        total *= rain_loss
+    if with_interference:
+        interference(total)
+    levels = radar._receive(total, noise.copy())
+
+    echoes = _Echoes(clutter, targets, first_hit, rain_loss, rain_clutter)
+    p_db, got = radar._video(echoes, noise, interference if with_interference else None)
+    assert np.array_equal(clutter, plain_clutter)  # the shadow, in place
+    assert np.array_equal(p_db, total) and np.array_equal(got, levels)
+    assert 0 < np.count_nonzero(levels) < levels.size
