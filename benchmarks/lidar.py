@@ -17,6 +17,8 @@ Usage::
 from __future__ import annotations
 
 import argparse
+import datetime as dt
+import json
 import statistics
 import sys
 import tempfile
@@ -80,11 +82,93 @@ def raw_embree_rays_per_s(scenario, t_s: float, repeats: int) -> tuple[float, in
     return frozen_scene_rays_per_s(world.objects, rays, t_s, repeats), rays.shape[0]
 
 
+#: Parts of a revolution timed by :func:`part_times`: (owner module, class or None, attribute, label).
+PARTS = (
+    ("raysim.sensors.lidar", "LidarRenderer", "_sensor_rays", "sensor-frame beams (hdl32e.beam_directions)"),
+    ("raysim.sensors.lidar", "LidarRenderer", "_world_rays", "world rays (own-ship pose per firing)"),
+    ("raysim.scene.engine", "Scene", "cast", "ray engine: cast into the world (Embree and its pre-pass)"),
+    ("raysim.sensors.lidar", "LidarRenderer", "_cast_past_own_ship", "own-ship beam table and the cast"),
+    ("raysim.sea", "FoamField", "is_foam", "foam field (raysim.sea)"),
+    ("raysim.sensors.lidar", "LidarRenderer", "_world_echoes", "echo physics, foam included"),
+    ("raysim.sensors.lidar", "LidarRenderer", "_returns", "returns (echo selection, noise, quantisation)"),
+    ("raysim.sensors.lidar", "LidarRenderer", "measure", "measure (all of the above)"),
+    ("raysim.sensors.lidar", "LidarRenderer", "packets", "data packets"),
+    ("raysim.sensors.lidar", "LidarRenderer", "_write_in_order", "PCAP writing (position packets included)"),
+    ("raysim.sensors.lidar_sweeps", "LidarSweeps", "add", "sweeps: points and NPZ writing"),
+)
+
+
+def part_times(scenario, duration_s: float) -> tuple[list[tuple[str, float]], float]:
+    """Mean wall time per revolution of each of :data:`PARTS` in one render, ms, and of the whole revolution.
+
+    The parts are wrapped with timers for the run and restored after; nested parts overlap
+    (the cast is inside the own-ship part, everything but the writers inside ``measure``).
+    """
+    import functools
+    import importlib
+
+    from raysim.materials import material_index
+    from raysim.sensors.carrier import CarrierScene
+
+    spent: dict[str, float] = {label: 0.0 for *_, label in PARTS}
+    saved = []
+    for module, owner, name, label in PARTS:
+        target = getattr(importlib.import_module(module), owner)
+        original = getattr(target, name)
+
+        def timed(*args, _original=original, _label=label, **kwargs):
+            start = time.perf_counter()
+            try:
+                return _original(*args, **kwargs)
+            finally:
+                spent[_label] += time.perf_counter() - start
+
+        saved.append((target, name, original))
+        setattr(target, name, functools.wraps(original)(timed))
+    try:
+        s = with_overrides(scenario, duration_s=duration_s, sensors=("lidar",))
+        world = World(s)
+        renderer = LidarRenderer(world, CarrierScene(world.scene_objects(), sea_material=material_index("sea")))
+        with tempfile.TemporaryDirectory() as tmp:
+            renderer.run(Path(tmp))
+    finally:
+        for target, name, original in saved:
+            setattr(target, name, original)
+    n = len(renderer.chunk_wall_s)
+    whole = sum(wall for _, wall in renderer.chunk_wall_s) / n
+    return [(label, 1e3 * spent[label] / n) for *_, label in PARTS], 1e3 * whole
+
+
+def variation_notes(figures: dict, previous: list[Path]) -> list[str]:
+    """A notes table of this run's key figures beside those of earlier runs (their ``--json`` files)."""
+    runs = [json.loads(p.read_text(encoding="utf-8")) for p in previous] + [figures]
+    keys = [("multiple_of_real_time", "multiple of real time (marginal, median revolution)", "{:.2f}"),
+            ("multiple_of_real_time_mean", "multiple of real time, mean revolution", "{:.2f}"),
+            ("multiple_of_real_time_whole_runs", "multiple of real time, whole runs", "{:.2f}"),
+            ("renderer_rays_per_s", "renderer rays/s, M", "{:.2f}"),
+            ("raw_embree_rays_per_s", "raw Embree rays/s, M", "{:.2f}"),
+            ("fraction_of_raw_embree", "fraction of raw Embree", "{:.3f}"),
+            ("peak_memory_mb", "peak memory (short, long render), MB", "{}")]
+    head = "| figure | " + " | ".join(r.get("generated", f"run {i + 1}") for i, r in enumerate(runs)) + " |"
+    lines = ["Run-to-run variation (this script run twice, one run after the other; the LiDAR code the same):", "", head,
+             "|---|" + "---:|" * len(runs)]
+    for key, label, fmt in keys:
+        cells = []
+        for r in runs:
+            v = r.get(key)
+            v = v / 1e6 if v is not None and key.endswith("rays_per_s") else v
+            cells.append("-" if v is None else fmt.format(v))
+        lines.append(f"| {label} | " + " | ".join(cells) + " |")
+    return lines + [""]
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results" / "lidar.md")
     parser.add_argument("--json", type=Path, help="also write the figures as JSON")
+    parser.add_argument("--previous", type=Path, action="append", default=[],
+                        help="the --json of an earlier run, shown beside this one's figures (repeatable)")
     args = parser.parse_args(argv)
     scenario = load_scenario(ROOT / "scenarios" / "busy_open_sea.yaml")
     short, long = (1.0, 3.0) if args.quick else (2.0, 12.0)
@@ -125,8 +209,16 @@ def main(argv=None) -> int:
     ]
     figures = {"multiple_of_real_time": 1.0 / marginal, "fraction_of_raw_embree": lidar_rays_per_s / raw,
                "renderer_rays_per_s": lidar_rays_per_s, "raw_embree_rays_per_s": raw, "points_per_s": points,
-               "startup_s": startup, "wall_s_per_scenario_s": marginal}
-    publish("LiDAR rendering benchmark", intro, rows, args.out, args.json, figures)
+               "startup_s": startup, "wall_s_per_scenario_s": marginal, "multiple_of_real_time_mean": 1.0 / mean_chunk,
+               "multiple_of_real_time_whole_runs": 1.0 / marginal_two,
+               "peak_memory_mb": ", ".join(f"{mb:.0f}" for mb in memory.values()),
+               "generated": f"{dt.datetime.now(dt.timezone.utc):%H:%M} UTC"}
+    parts, whole_ms = part_times(scenario, 2.0 if args.quick else 4.0)
+    notes = [*variation_notes(figures, args.previous),
+             f"Where a revolution's time goes (one {2.0 if args.quick else 4.0:g} s render with the parts timed, "
+             f"mean over revolutions; {whole_ms:.1f} ms a revolution in that run, nested parts overlap):", "",
+             "| part | ms a revolution |", "|---|---:|", *[f"| {label} | {ms:.2f} |" for label, ms in parts], ""]
+    publish("LiDAR rendering benchmark", intro, rows, args.out, args.json, figures, notes)
     return 0
 
 
