@@ -383,7 +383,8 @@ def quantise(power_db, floor_db: float, step_db: float, levels: int = 16) -> np.
     """
     p = np.asarray(power_db)
     p = p.astype(np.float32) if p.dtype != np.float32 else p
-    v = (p - np.float32(floor_db)) * np.float32(1.0 / step_db)
+    v = p - np.float32(floor_db)
+    v *= np.float32(1.0 / step_db)
     np.fmax(v, np.float32(0.0), out=v)  # fmax: NaN (and -inf) -> 0
     np.minimum(v, np.float32(levels - 0.5), out=v)  # +inf -> the top level
     return v.astype(np.uint8)  # truncation is floor on [0, levels)

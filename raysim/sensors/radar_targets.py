@@ -109,6 +109,7 @@ class TargetEchoes:
         self.snr_amp = np.sqrt(phys.snr(1.0, renderer.r64, **renderer.snr_kw))  # (N,) sqrt(SNR) per sqrt(m^2)
         self._az_kernel_f_row = renderer.az_kernel_f.astype(np.complex64)[None, :]  # (1, S) voltage pattern spectrum
         self._az_power_pattern_f_row = np.fft.rfft(renderer.az_power_pattern)[None, :]  # (1, S // 2 + 1) power pattern
+        self._stationary: dict[int, tuple[np.ndarray, np.ndarray]] = {}  # poses of stationary objects, by id
         skirt = renderer.range_skirt_kernel
         self._skirt_peak = 0.0 if skirt is None else float(np.max(skirt))
 
@@ -130,9 +131,9 @@ class TargetEchoes:
             idx = np.flatnonzero(oid == obj)
             motion = self.motion[int(obj)]
             if isinstance(motion, Stationary):  # land, buoys: one pose for all hits, no velocity (the same values)
-                now = motion.poses(np.zeros(1))
-                rotation = np.broadcast_to(now.rotation(), (idx.size, 3, 3))
-                body = np.einsum("nji,nj->ni", rotation, point[idx] - now.position_m)
+                rotation_1, position_1 = self._stationary_pose(int(obj), motion)
+                rotation = np.broadcast_to(rotation_1, (idx.size, 3, 3))
+                body = np.einsum("nji,nj->ni", rotation, point[idx] - position_1)
             else:
                 now = motion.poses(t_hit[idx])
                 later = motion.poses(t_hit[idx] + VELOCITY_STEP_S)
@@ -141,6 +142,14 @@ class TargetEchoes:
             relief[idx] = RELIEF_PHASE_SCALE * 2.0 * math.pi * np.sum(
                 np.cos(body @ self.relief_k.T + self.relief_phase + 1.7 * float(obj)), axis=1)
         return velocity, relief
+
+    def _stationary_pose(self, object_id: int, motion: Stationary) -> tuple[np.ndarray, np.ndarray]:
+        """(1, 3, 3) body -> world rotation and (1, 3) position, m, of a stationary object (formed once, kept)."""
+        pose = self._stationary.get(object_id)
+        if pose is None:
+            now = motion.poses(np.zeros(1))
+            pose = self._stationary[object_id] = (now.rotation(), now.position_m)
+        return pose
 
     def _material(self, material: np.ndarray, cos_i: np.ndarray):
         m = self.r.materials

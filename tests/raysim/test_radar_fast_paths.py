@@ -232,3 +232,23 @@ def test_video_in_halves_equals_the_whole_revolution_form(radar, with_targets, w
     assert np.array_equal(clutter, plain_clutter)  # the shadow, in place
     assert np.array_equal(p_db, total) and np.array_equal(got, levels)
     assert 0 < np.count_nonzero(levels) < levels.size
+
+
+def test_relief_of_a_stationary_object_from_its_kept_pose_equals_a_fresh_pose(radar):
+    import math
+
+    from raysim.motion import Stationary
+
+    motion = Stationary([120.0, -40.0, 0.5], 0.7)
+    radar.targets.motion[99] = motion
+    rng = np.random.default_rng(12)
+    point = rng.uniform(-50.0, 50.0, (300, 3)) + motion.position_m
+    oid = np.full(300, 99)
+    now = motion.poses(np.zeros(1))
+    body = np.einsum("nji,nj->ni", np.broadcast_to(now.rotation(), (300, 3, 3)), point - now.position_m)
+    expected = radar_targets.RELIEF_PHASE_SCALE * 2.0 * math.pi * np.sum(
+        np.cos(body @ radar.targets.relief_k.T + radar.targets.relief_phase + 1.7 * 99.0), axis=1)
+    for _ in range(2):  # the first forms the pose, the second reads it back
+        velocity, relief = radar.targets._object_terms(oid, np.full(300, 3.0), point)
+        assert np.array_equal(relief, expected) and not velocity.any()
+    del radar.targets.motion[99]
