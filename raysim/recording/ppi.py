@@ -97,11 +97,16 @@ def _font() -> ImageFont.FreeTypeFont | ImageFont.ImageFont:
     return font
 
 
-def _corner_text(draw: ImageDraw.ImageDraw, size_px: int, corner: str, lines: list[str]) -> None:
-    """Write ``lines`` into ``corner`` (``"tl"``, ``"tr"``, ``"bl"``, ``"br"``), outside the display circle."""
+def _corner_text(draw: ImageDraw.ImageDraw, size_px: int, corner: str, lines: list[str], skip: int = 0) -> None:
+    """Write ``lines`` into ``corner`` (``"tl"``, ``"tr"``, ``"bl"``, ``"br"``), outside the display circle.
+
+    The first ``skip`` lines are left out (their places kept): a top corner's first lines drawn elsewhere.
+    """
     font = _font()
     top = corner[0] == "t"
     for k, line in enumerate(lines):
+        if k < skip:
+            continue
         y = 6 + k * LINE_PX if top else size_px - 6 - (len(lines) - k) * LINE_PX
         x = 6 if corner[1] == "l" else size_px - 6 - draw.textlength(line, font=font)
         draw.text((x, y), line, fill=TEXT_INK, font=font)
@@ -189,9 +194,12 @@ def _rings(size_px: int, ring_labels: tuple[str, ...]) -> tuple[np.ndarray, np.n
 
 
 @lru_cache(maxsize=8)
-def _fixed_text(size_px: int, bottom_left: tuple[str, ...], bottom_right: tuple[str, ...]) -> tuple[Image.Image, ...]:
-    """The fixed corner texts as (mask "1" picture, bounding box) pairs to paste TEXT_INK through (cached)."""
-    painted, _ = _overlay(size_px, lambda draw: (_corner_text(draw, size_px, "bl", list(bottom_left)),
+def _fixed_text(size_px: int, top_left: str, bottom_left: tuple[str, ...],
+                bottom_right: tuple[str, ...]) -> tuple[Image.Image, ...]:
+    """The fixed corner texts (the top left's first line, the bottom corners) as a mask "1" picture and its bounding
+    box, to paste TEXT_INK through (cached per display)."""
+    painted, _ = _overlay(size_px, lambda draw: (_corner_text(draw, size_px, "tl", [top_left]),
+                                                 _corner_text(draw, size_px, "bl", list(bottom_left)),
                                                  _corner_text(draw, size_px, "br", list(bottom_right))))
     mask = np.zeros(size_px * size_px, bool)
     mask[painted] = True
@@ -205,7 +213,7 @@ def ppi_image(echo: np.ndarray, azimuth_deg: np.ndarray, heading_deg: np.ndarray
     """North-up PPI of one sweep, ``size_px`` x ``size_px`` pixels, with its corner texts.
 
     Drawn in this order: the video, the range rings and their labels, the heading line, the corner texts. What is
-    fixed for a display (rings, labels, range and receiver texts) is drawn once and pasted (:func:`_overlay`): the
+    fixed for a display (rings, labels, "N up", range and receiver texts) is drawn once and pasted (:func:`_overlay`): the
     same bytes as :func:`ppi_image_reference`, which draws everything every time.
 
     Parameters
@@ -238,11 +246,11 @@ def ppi_image(echo: np.ndarray, azimuth_deg: np.ndarray, heading_deg: np.ndarray
     draw = ImageDraw.Draw(image)
     h = np.radians(heading_deg[0])
     draw.line([half, half, half + half * np.sin(h), half - half * np.cos(h)], fill=HEADING_INK)
-    for corner, lines in _changing_corners(float(heading_deg[0]), None if time_s is None else float(time_s[0]),
-                                           labels).items():
-        _corner_text(draw, size_px, corner, lines)
+    changing = _changing_corners(float(heading_deg[0]), None if time_s is None else float(time_s[0]), labels)
+    for corner, lines in changing.items():  # the top left's first line ("N up") is the same every time: pasted
+        _corner_text(draw, size_px, corner, lines, skip=1 if corner == "tl" else 0)
     fixed = _fixed_corners(range_m, labels)
-    pasted = _fixed_text(size_px, tuple(fixed["bl"]), tuple(fixed["br"]))
+    pasted = _fixed_text(size_px, changing["tl"][0], tuple(fixed["bl"]), tuple(fixed["br"]))
     if pasted:
         image.paste(TEXT_INK, pasted[1], pasted[0])
     return image

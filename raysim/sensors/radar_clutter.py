@@ -241,7 +241,8 @@ class SeaClutter:
         width = max(1, int(round(self.beam_spokes / self.sub)))
         zt = uniform_filter1d(uniform_filter1d(zt, width, axis=1, mode="wrap"), width, axis=1, mode="wrap")
         std = np.maximum(uniform_filter1d(zt.std(axis=1), TEXTURE_STD_WINDOW_BINS, mode="nearest"), 1e-6)
-        z = np.ascontiguousarray((zt / std[:, None]).T)
+        zt /= std[:, None]  # a fresh array from the filter: divided in place
+        z = np.ascontiguousarray(zt.T)
         texture = self.gamma(z, self.ward_log_nu(psi_c_deg, cos_up))
         return np.maximum(texture, np.float32(TEXTURE_FLOOR), out=texture)
 
