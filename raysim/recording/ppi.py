@@ -139,9 +139,9 @@ def _annotate(draw: ImageDraw.ImageDraw, size_px: int, range_m: np.ndarray, head
         _corner_text(draw, size_px, corner, lines)
 
 
-@lru_cache(maxsize=4)
 def _pixel_geometry(size_px: int, samples: int, range_scale_m: float):
-    """The pixels inside the range scale (flat indices) with their bearing bin and sample index (cached per display)."""
+    """The pixels inside the range scale (flat indices) with their bearing bin and sample index (kept per display in
+    the order :func:`_pixel_geometry_by_bin` puts them in, not in this one)."""
     half = size_px / 2.0
     y, x = np.mgrid[0:size_px, 0:size_px]
     dx, dy = x - half + 0.5, half - y - 0.5
