@@ -127,12 +127,12 @@ class Scene:
             hits = self._static.cast_all(batch)
             if self.sea:
                 self._merge_sea(hits, batch)
-        else:
+            if finite_range:
+                drop_beyond(hits, max_range)
+        else:  # the sea ranges and the static hits merged are already within the range limit
             hits = self._sea_hits(batch)
             if self._static is not None:
                 self._static.merge_some(hits, batch, batch.static_candidates)
-        if finite_range:
-            drop_beyond(hits, max_range)
         if len(self._moving):
             self._moving.cast(hits, batch)
         return hits
@@ -145,7 +145,7 @@ class Scene:
         need_cells = self.cull and (self._static is not None or movers)
         if not need_cells:
             if self.sea:
-                batch.sea_range = intersect_sea(batch.origins[:, 2], batch.directions[:, 2])
+                batch.sea_range = self._sea_range(batch, slice(None))
             return
         parts = split_run(batch.n, self._workers, lambda a, b: origin_box(batch.origins[a:b]))
         lo = np.min([p[0] for p in parts], axis=0)
@@ -157,7 +157,7 @@ class Scene:
             near_table = None
         if near_table is None and not movers:  # cells are of no use: sea only
             if self.sea:
-                batch.sea_range = intersect_sea(batch.origins[:, 2], batch.directions[:, 2])
+                batch.sea_range = self._sea_range(batch, slice(None))
             return
         n = batch.n
         batch.cells = np.empty(n, dtype=np.uint16)
@@ -175,7 +175,7 @@ class Scene:
             d32 = batch.directions[s:e].T.astype(np.float32)
             batch.cells[s:e] = direction_cells(d32[0], d32[1], d32[2])
             if batch.sea_range is not None:
-                batch.sea_range[s:e] = intersect_sea(batch.origins[s:e, 2], batch.directions[s:e, 2])
+                batch.sea_range[s:e] = self._sea_range(batch, slice(s, e))
             if near_table is not None:
                 near = np.take(near_table, batch.cells[s:e])
                 cand.append(np.flatnonzero(near < batch.limit(slice(s, e))) + s)
@@ -185,23 +185,42 @@ class Scene:
 
     # --------------------------------------------------------------------- sea
 
+    @staticmethod
+    def _sea_range(batch: RayBatch, s: slice) -> np.ndarray:
+        """Range to the sea of rays ``s``, metres (``inf`` where none or beyond the ray's range limit)."""
+        mr = batch.max_range
+        if mr is not None and mr.ndim:
+            mr = mr[s]
+        return intersect_sea(batch.origins[s, 2], batch.directions[s, 2], mr)
+
     def _sea_normal_z(self, batch: RayBatch) -> np.ndarray:
         """(N,) float32: z of the sea normal facing each ray (+1 from above, -1 from below)."""
         return np.where(batch.directions[:, 2] < 0, np.float32(1.0), np.float32(-1.0))
 
     def _sea_hits(self, batch: RayBatch) -> Hits:
-        """Hits of the sea alone (no hit everywhere if the scene has no sea)."""
+        """Hits of the sea alone (no hit everywhere if the scene has no sea).
+
+        Integer passes instead of masked writes: where ``hit``, the id is ``NO_HIT + (SEA_ID - NO_HIT)``,
+        the material ``-1 + (sea_material + 1)`` and the normal's z ``+1`` from above, ``-1`` from below
+        (an int8 sign times ``hit``: exactly ``0.0``, never ``-0.0``, elsewhere).
+        """
         n = batch.n
         if not self.sea:
             return Hits.empty(n)
         rng = batch.sea_range  # owned by this batch: returned as is
         hit = rng < np.inf
-        obj = np.full(n, NO_HIT, dtype=np.int32)
-        np.copyto(obj, SEA_ID, where=hit)
-        material = np.full(n, -1, dtype=np.int16)
-        np.copyto(material, self.sea_material, where=hit)
+        hit8 = hit.view(np.int8)
+        obj = hit.astype(np.int32)
+        obj *= SEA_ID - NO_HIT
+        obj += NO_HIT
+        material = hit.astype(np.int16)
+        material *= self.sea_material + 1
+        material -= 1
+        sign = (batch.directions[:, 2] < 0).view(np.int8) * np.int8(2)  # 2 from above, 0 from below
+        sign -= 1
+        sign *= hit8
         normal = np.zeros((n, 3), dtype=np.float32)
-        np.copyto(normal[:, 2], self._sea_normal_z(batch), where=hit)
+        normal[:, 2] = sign
         return Hits(rng, obj, normal, material, np.full(n, -1, dtype=np.int32))
 
     def _merge_sea(self, hits: Hits, batch: RayBatch) -> None:

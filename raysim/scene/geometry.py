@@ -26,7 +26,7 @@ SPHERE_PAD_M = 0.01
 """Safety margin added to bounding spheres (float32 round-off), metres."""
 
 
-def intersect_sea(oz_m: np.ndarray, dz: np.ndarray) -> np.ndarray:
+def intersect_sea(oz_m: np.ndarray, dz: np.ndarray, max_range_m: float | np.ndarray | None = None) -> np.ndarray:
     """Range along each ray to the flat sea surface ``z = 0``.
 
     Parameters
@@ -35,18 +35,23 @@ def intersect_sea(oz_m: np.ndarray, dz: np.ndarray) -> np.ndarray:
         Ray origin heights above mean sea level, metres.
     dz : (N,) float
         Vertical components of the unit ray directions.
+    max_range_m : float, (N,) float or None
+        Ranges beyond this count as no hit (``inf``), metres (compared in float64);
+        None: no limit.
 
     Returns
     -------
     (N,) float64
         Range to the plane, metres; ``inf`` where the ray runs parallel to it or
-        away from it.
+        away from it (or meets it beyond ``max_range_m``).
     """
     with np.errstate(divide="ignore", invalid="ignore"):
         t = np.divide(oz_m, dz, dtype=np.float64)
-    np.negative(t, out=t)
-    t[~(t >= 0.0)] = np.inf  # also catches nan (0 / 0)
-    return t
+        np.negative(t, out=t)
+        keep = t >= 0.0  # also drops nan (0 / 0)
+    if max_range_m is not None:
+        keep &= t <= max_range_m
+    return np.where(keep, t, np.inf)
 
 
 def pseudo_azimuth(x: np.ndarray, y: np.ndarray) -> np.ndarray:

@@ -245,13 +245,15 @@ class StaticPart:
         return Hits(rng, obj, normal, material, prim)
 
     def merge_some(self, hits: Hits, batch: RayBatch, idx: np.ndarray) -> None:
-        """Cast rays ``idx`` at the static scene; keep hits nearer than the current ones (in place).
+        """Cast rays ``idx`` at the static scene; keep hits nearer than the current ones and within the rays'
+        range limit (in place).
 
         Parameters
         ----------
         hits : Hits
             The batch's N current hits, updated in place.
         batch : RayBatch
+            Its ``max_range`` (metres, or None) bounds the hits kept.
         idx : (M,) int
             Rays to cast.
         """
@@ -262,7 +264,10 @@ class StaticPart:
         pack_rays(batch.origins, batch.directions, st.offset_m, self.workers, out=rays, idx=idx)
         res = st.scene.cast_rays(o3d.core.Tensor.from_numpy(rays), nthreads=self.nthreads)
         t = res["t_hit"].numpy()
-        sel = np.flatnonzero(t < hits.range_m[idx])  # misses are inf
+        sel = np.flatnonzero(t < np.take(hits.range_m, idx))  # misses are inf
+        if sel.size and batch.max_range is not None:  # float32 ranges against the float64 limit, in float64
+            mr = batch.max_range if batch.max_range.ndim == 0 else np.take(batch.max_range, np.take(idx, sel))
+            sel = sel[np.take(t, sel).astype(np.float64) <= mr]
         if sel.size == 0:
             return
         j = idx[sel]
