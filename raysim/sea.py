@@ -63,7 +63,19 @@ class FoamField:
         self.threshold = float(ndtri(1.0 - self.coverage)) if 0.0 < self.coverage < 1.0 else (np.inf if self.coverage <= 0 else -np.inf)
 
     def is_foam(self, x_m: np.ndarray, y_m: np.ndarray, t_s: np.ndarray) -> np.ndarray:
-        """(N,) bool: whether the sea at (x, y) carries foam at time t."""
+        """Whether the sea carries foam at points of it at given times.
+
+        Parameters
+        ----------
+        x_m, y_m : (N,) float
+            East and north positions on the sea, metres.
+        t_s : (N,) float
+            Times, seconds since scenario start.
+
+        Returns
+        -------
+        (N,) bool
+        """
         if self.coverage <= 0.0 or x_m.shape[0] == 0:
             return np.zeros(np.shape(x_m), dtype=bool)
         # float32 about a reference point and time (folded into the phases in float64) keeps the
@@ -71,11 +83,63 @@ class FoamField:
         x0, y0, t0 = float(x_m[0]), float(y_m[0]), float(t_s[0])
         phase = np.mod(self.phase + self.kx * x0 + self.ky * y0 - self.omega * t0, 2 * np.pi).astype(np.float32)
         local = np.empty((x_m.shape[0], 3), dtype=np.float32)
-        local[:, 0] = x_m - x0
-        local[:, 1] = y_m - y0
-        local[:, 2] = t_s - t0
+        np.subtract(x_m, x0, out=local[:, 0], casting="same_kind")  # in the inputs' precision, then rounded
+        np.subtract(y_m, y0, out=local[:, 1], casting="same_kind")
+        np.subtract(t_s, t0, out=local[:, 2], casting="same_kind")
         waves = np.stack([self.kx, self.ky, -self.omega]).astype(np.float32)  # (3, N_WAVES)
         arg = local @ waves
-        arg += phase
-        field = np.cos(arg, out=arg).sum(axis=1) / np.float32(np.sqrt(N_WAVES / 2.0))
+        add_to_rows(arg, phase)
+        field = sum_rows(np.cos(arg, out=arg))
+        field /= np.float32(np.sqrt(N_WAVES / 2.0))
         return field > self.threshold
+
+
+#: Rows of a (N, W) array added to at once by :func:`add_to_rows` (long inner loops).
+_ROWS_AT_ONCE = 32
+
+
+def add_to_rows(a: np.ndarray, row: np.ndarray) -> None:
+    """``a += row`` for a C-contiguous (N, W) array, the same sums, over rows of ``_ROWS_AT_ONCE * W`` values.
+
+    Broadcasting a short row steps W values at a time; the tiled row makes the inner loop long.
+
+    Parameters
+    ----------
+    a : (N, W) float32, C-contiguous
+        Added to in place.
+    row : (W,) float32
+    """
+    m = a.shape[0] // _ROWS_AT_ONCE * _ROWS_AT_ONCE
+    if m and a.flags.c_contiguous:
+        block = a[:m].reshape(-1, _ROWS_AT_ONCE * a.shape[1])
+        block += np.tile(row, _ROWS_AT_ONCE)
+        a[m:] += row
+    else:
+        a += row
+
+
+def sum_rows(a: np.ndarray) -> np.ndarray:
+    """``a.sum(axis=1)`` of a (N, 8) float32 array, the same values, by seven column additions.
+
+    NumPy sums a contiguous row of 8 values pairwise with 8 partial sums:
+    ``((a0 + a1) + (a2 + a3)) + ((a4 + a5) + (a6 + a7))`` (``pairwise_sum`` in its
+    ``loops_utils.h``); the columns added in that order give the same values (up to
+    the sign of a zero sum), without a reduction per row. Other widths: ``a.sum(axis=1)``.
+
+    Parameters
+    ----------
+    a : (N, W) float32
+
+    Returns
+    -------
+    (N,) float32
+    """
+    if a.ndim != 2 or a.shape[1] != 8:
+        return a.sum(axis=1)
+    c = [a[:, k] for k in range(8)]
+    left = np.add(c[0], c[1])
+    left += np.add(c[2], c[3])
+    right = np.add(c[4], c[5])
+    right += np.add(c[6], c[7])
+    left += right
+    return left

@@ -51,3 +51,53 @@ def test_foam_is_a_function_of_place_and_time_only():
     # evaluated in any order or grouping: the same answer (the reference point only changes float32 rounding)
     order = rng.permutation(5000)
     assert (a.is_foam(x[order], y[order], t[order]) == a.is_foam(x, y, t)[order]).mean() > 0.999
+
+
+def _plain_is_foam(field: FoamField, x_m: np.ndarray, y_m: np.ndarray, t_s: np.ndarray) -> np.ndarray:
+    """The foam test as first written (broadcast phase add, row reduction, division, threshold)."""
+    from raysim.sea import N_WAVES
+
+    x0, y0, t0 = float(x_m[0]), float(y_m[0]), float(t_s[0])
+    phase = np.mod(field.phase + field.kx * x0 + field.ky * y0 - field.omega * t0, 2 * np.pi).astype(np.float32)
+    local = np.empty((x_m.shape[0], 3), dtype=np.float32)
+    local[:, 0] = x_m - x0
+    local[:, 1] = y_m - y0
+    local[:, 2] = t_s - t0
+    waves = np.stack([field.kx, field.ky, -field.omega]).astype(np.float32)
+    arg = local @ waves
+    arg += phase
+    value = np.cos(arg, out=arg).sum(axis=1) / np.float32(np.sqrt(N_WAVES / 2.0))
+    return value > field.threshold
+
+
+@pytest.mark.parametrize("n", [1, 31, 32, 1000, 27_613])
+@pytest.mark.parametrize("dtype", [np.float64, np.float32])
+def test_the_foam_test_equals_the_plain_formula_bit_for_bit(n, dtype):
+    rng = np.random.default_rng(n)
+    for seed, (wind, state) in enumerate([(10.0, 4), (15.0, 5), (25.0, 6)]):
+        field = FoamField(wind, state, 37.0 * seed, np.random.default_rng(seed))
+        x = rng.uniform(-3000.0, 3000.0, n).astype(dtype)
+        y = rng.uniform(-3000.0, 3000.0, n).astype(dtype)
+        t = np.sort(rng.uniform(100.0, 100.1, n)).astype(dtype)
+        got = field.is_foam(x, y, t)
+        assert got.dtype == bool and np.array_equal(got, _plain_is_foam(field, x, y, t))
+
+
+def test_row_sums_and_row_adds_equal_numpys():
+    """sum_rows keeps NumPy's pairwise order (other orders differ on about half the rows); add_to_rows is +=."""
+    from raysim.sea import add_to_rows, sum_rows
+
+    rng = np.random.default_rng(12)
+    a = np.cos(rng.uniform(-40.0, 40.0, (50_017, 8))).astype(np.float32)
+    assert np.array_equal(sum_rows(a), a.sum(axis=1))
+    in_order = a[:, 0].copy()
+    for k in range(1, 8):
+        in_order += a[:, k]
+    assert np.count_nonzero(in_order != a.sum(axis=1)) > 1000  # the order matters: the test can fail
+    assert np.array_equal(sum_rows(a[:, :5]), a[:, :5].sum(axis=1))
+    row = rng.uniform(0.0, 6.3, 8).astype(np.float32)
+    for n in (0, 5, 32, 50_017):
+        b, c = a[:n].copy(), a[:n].copy()
+        add_to_rows(b, row)
+        c += row
+        assert b.tobytes() == c.tobytes()
