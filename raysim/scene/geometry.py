@@ -155,6 +155,25 @@ class SphereCells:
         return label, lo, hi, self.e0[label], self.e1[label]
 
 
+def _sphere_distances(centres: np.ndarray, radii: np.ndarray, origin_centre: np.ndarray,
+                      spread: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Offsets (K, 3), distances (K,) and grown radii (K,) of K spheres from the origin box, metres."""
+    rs = radii + spread  # Minkowski sum with the origin box's bounding sphere
+    v = np.asarray(centres, dtype=np.float64).reshape(-1, 3) - origin_centre
+    dist = np.sqrt(np.einsum("ij,ij->i", v, v))
+    return v, dist, rs
+
+
+def sphere_near_m(centres: np.ndarray, radii: np.ndarray, origin_centre: np.ndarray, spread: float) -> np.ndarray:
+    """(K,) float64: :attr:`SphereCells.near_m` of :func:`sphere_cells` alone (the same values), metres.
+
+    The nearest distance at which a ray from the origin box can meet each sphere, without the
+    cells: enough to see that no sphere is within a range limit.
+    """
+    _, dist, rs = _sphere_distances(centres, radii, origin_centre, spread)
+    return np.maximum(dist - rs, 0.0)
+
+
 def sphere_cells(
     centres: np.ndarray, radii: np.ndarray, origin_centre: np.ndarray, spread: float
 ) -> SphereCells:
@@ -175,9 +194,7 @@ def sphere_cells(
     -------
     SphereCells
     """
-    rs = radii + spread  # Minkowski sum with the origin box's bounding sphere
-    v = np.asarray(centres, dtype=np.float64).reshape(-1, 3) - origin_centre
-    dist = np.sqrt(np.einsum("ij,ij->i", v, v))
+    v, dist, rs = _sphere_distances(centres, radii, origin_centre, spread)
     h = np.hypot(v[:, 0], v[:, 1])
     pad = CELL_PAD_RAD
     with np.errstate(divide="ignore", invalid="ignore"):

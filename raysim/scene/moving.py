@@ -43,7 +43,7 @@ import open3d as o3d
 
 from raysim.pose import rotation_matrices
 from raysim.scene.geometry import (AZ_BINS, EL_BINS, SPHERE_PAD_M, gather_columns, pairs_hit_boxes, pairs_reach_spheres,
-                                   sphere_cells)
+                                   sphere_cells, sphere_near_m)
 from raysim.scene.hits import Hits, SceneObject
 from raysim.scene.poses import PoseBank, swept_spheres
 from raysim.scene.rays import RayBatch
@@ -212,10 +212,10 @@ class MovingPart:
         tmin, tmax = float(batch.times.min()), float(batch.times.max())
         range_cap = np.inf if batch.max_range is None else float(np.max(batch.max_range))
         centres, radii = swept_spheres(self.bank, self.speed, self.radius, tmin, tmax)
+        if not np.any(sphere_near_m(centres, radii, batch.origin_centre, batch.spread_m) <= range_cap):
+            return  # every object beyond the range limit (sphere_cells' near_m, without the cells)
         cells = sphere_cells(centres, radii, batch.origin_centre, batch.spread_m)
         live = np.flatnonzero(cells.near_m <= range_cap)
-        if live.size == 0:
-            return
         limit = hits.range_m
         if batch.max_range is not None:
             limit = np.minimum(limit, batch.max_range)

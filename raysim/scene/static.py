@@ -23,7 +23,7 @@ import numpy as np
 import open3d as o3d
 
 from raysim.scene.geometry import (AZ_BINS, EL_BINS, bounding_sphere, direction_cells, face_against, intersect_sea,
-                                   sphere_cells)
+                                   sphere_cells, sphere_near_m)
 from raysim.scene.hits import NO_HIT, Hits, SceneObject
 from raysim.scene.rays import CHUNK, RayBatch, offset_tile, pack_rays, scratch, split_run
 
@@ -65,7 +65,8 @@ class StaticPart:
     sphere_radii: np.ndarray  # (G,) float64
     nthreads: int = 0
     workers: int = 1
-    _near_cache: tuple | None = None  # grown box: centre (3,), spread m; far objects (G,) bool; their table or None
+    _near_cache: tuple | None = None  # grown box: centre (3,), spread m; far objects (G,) bool; their table or None;
+    # the table's least entry (m, inf if none)
 
     @classmethod
     def build(cls, objects: Sequence[SceneObject], nthreads: int, workers: int) -> "StaticPart":
@@ -132,11 +133,13 @@ class StaticPart:
         sensor on a moving ship). A table built for a larger box is conservative for a smaller one inside it: it
         lets through a few more rays, which miss or hit beyond their limit, so the hits are the same. The other
         objects' part is built for the box itself at every call, and the two are merged by their minimum.
+        Objects that cannot be met within the batch's range limit are left out (:meth:`_within`), and the far
+        part too when all its entries lie beyond that limit: the rays cast are the same.
 
         Parameters
         ----------
         batch : RayBatch
-            With its origin box (``origin_centre``, ``spread_m``) set.
+            With its origin box (``origin_centre``, ``spread_m``) set; its ``max_range`` (or None).
 
         Returns
         -------
@@ -147,26 +150,55 @@ class StaticPart:
         reach = np.linalg.norm(self.sphere_centres - centre, axis=1) - self.sphere_radii
         if np.any(reach <= spread):
             return None
-        everything = np.ones(reach.size, dtype=bool)
+        cap = np.inf if batch.max_range is None else float(np.max(batch.max_range))
+        within = self._within(centre, spread, cap)
         if spread > NEAR_TABLE_MARGIN_M:
-            return self._build_near_table(everything, centre, spread)
+            return self._build_near_table(within, centre, spread)
         cached = self._near_cache
         if cached is None or np.linalg.norm(centre - cached[0]) + spread > cached[1]:
             grown = spread + NEAR_TABLE_MARGIN_M
             far = reach - grown >= NEAR_TABLE_FAR_M
-            cached = (centre.copy(), grown, far, self._build_near_table(far, centre, grown) if far.any() else None)
+            far_table = self._build_near_table(far, centre, grown) if far.any() else None
+            far_min = np.inf if far_table is None else float(far_table.min())
+            cached = (centre.copy(), grown, far, far_table, far_min)
             self._near_cache = cached
-        far, far_table = cached[2], cached[3]
+        far, far_table, far_min = cached[2], cached[3], cached[4]
         if far_table is None:
-            return self._build_near_table(everything, centre, spread)
+            return self._build_near_table(within, centre, spread)
         if far.all():
             return far_table
-        return np.minimum(far_table, self._build_near_table(~far, centre, spread))
+        near_table = self._build_near_table(~far & within, centre, spread)
+        if far_min >= cap:  # no far object within the range limit: its entries decide no ray
+            return near_table
+        return np.minimum(far_table, near_table)
+
+    def _within(self, centre: np.ndarray, spread_m: float, cap_m: float) -> np.ndarray:
+        """(G,) bool: the objects that may be met within ``cap_m`` from the origin box (all if ``cap_m`` is inf).
+
+        A ray is cast at the static scene only if a table entry of its cell is below its limit (at most
+        ``cap_m``); an object whose entries are all at or beyond ``cap_m`` decides no ray and is left out
+        of the table (a margin of 1e-3 relative plus 1 mm covers the entries' rounding down by 1e-6).
+
+        Parameters
+        ----------
+        centre : (3,) float64
+            Centre of the origin box, metres.
+        spread_m : float
+            Its half-diagonal, metres.
+        cap_m : float
+            The batch's greatest range limit, metres.
+        """
+        if not np.isfinite(cap_m):
+            return np.ones(self.sphere_radii.size, dtype=bool)
+        near = sphere_near_m(self.sphere_centres, self.sphere_radii, centre, spread_m)
+        return near <= cap_m * (1.0 + 1e-3) + 1e-3
 
     def _build_near_table(self, which: np.ndarray, origin_centre: np.ndarray, spread_m: float) -> np.ndarray:
         """(CELLS,) float32: the near table of the objects ``which`` ((G,) bool) for origins within ``spread_m``
-        of ``origin_centre`` (metres)."""
+        of ``origin_centre`` (metres); ``inf`` everywhere for no object."""
         table = np.full((AZ_BINS, EL_BINS), np.inf, dtype=np.float32)
+        if not which.any():
+            return table.reshape(-1)
         cells = sphere_cells(self.sphere_centres[which], self.sphere_radii[which], origin_centre, spread_m)
         near = np.nextafter((cells.near_m * (1 - 1e-6)).astype(np.float32), np.float32(-np.inf))  # round down
         runs = cells.runs(np.arange(len(near)))

@@ -123,3 +123,52 @@ def test_the_culled_cast_cuts_sea_and_static_hits_at_the_range_limit_as_the_fina
         kinds = got.object_id
         assert (kinds == SEA_ID).sum() > 1000 and (kinds == NO_HIT).sum() > 1000
         assert ((kinds > 0) & (kinds < 40)).sum() > 100 and (kinds == 40).sum() > 10
+
+
+def _old_near_table(part, batch: RayBatch) -> np.ndarray | None:
+    """The near table as first written: every object, the far part's table merged whatever its entries."""
+    from raysim.scene import static
+
+    centre, spread = np.asarray(batch.origin_centre, dtype=np.float64), float(batch.spread_m)
+    reach = np.linalg.norm(part.sphere_centres - centre, axis=1) - part.sphere_radii
+    if np.any(reach <= spread):
+        return None
+    everything = np.ones(reach.size, dtype=bool)
+    if spread > static.NEAR_TABLE_MARGIN_M:
+        return part._build_near_table(everything, centre, spread)
+    far, far_table = part._near_cache[2], part._near_cache[3]  # the cache the new call left (same rule)
+    if far_table is None:
+        return part._build_near_table(everything, centre, spread)
+    if far.all():
+        return far_table
+    return np.minimum(far_table, part._build_near_table(~far, centre, spread))
+
+
+def test_the_near_table_leaves_out_what_lies_beyond_the_range_limit_and_the_same_rays_are_cast():
+    """Objects and the far part beyond the limit are left out: fewer table entries, the same candidates."""
+    rng = np.random.default_rng(21)
+    objects = []
+    for k in range(120):  # tiles 20 m to 2 km out: some within the 80 m limit, most beyond, many far
+        r, a = rng.uniform(20.0, 2000.0) if k >= 6 else rng.uniform(20.0, 70.0), rng.uniform(0.0, 2 * np.pi)
+        mesh = trimesh.creation.box(extents=rng.uniform(2.0, 30.0, 3))
+        objects.append(make_object(k + 1, mesh, Stationary([r * np.sin(a), r * np.cos(a), 2.0])))
+    scene = Scene(objects, sea=True)
+    d = rng.standard_normal((30_000, 3))
+    d[:, 2] = -np.abs(d[:, 2]) * 0.2 - 0.01  # down: the sea limits most rays
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    for step, limit in enumerate((80.0, 80.0, rng.uniform(10.0, 80.0, len(d)), np.inf)):
+        o = np.tile([3.0 * step, 0.0, 3.0], (len(d), 1)) + rng.uniform(-0.5, 0.5, (len(d), 3))
+        batch = RayBatch(o, d, np.zeros(len(d)), None if np.all(np.isinf(limit)) else np.asarray(limit))
+        scene._prepare(batch)
+        new_table = scene._static.near_table(batch)
+        old_table = _old_near_table(scene._static, batch)
+        limit_of = batch.limit(slice(None))
+        assert batch.cells is not None and batch.static_candidates is not None  # the culled path
+        cells = batch.cells
+        assert np.array_equal(np.flatnonzero(new_table[cells] < limit_of), np.flatnonzero(old_table[cells] < limit_of))
+        assert np.array_equal(np.flatnonzero(new_table[cells] < limit_of), batch.static_candidates)
+        if np.isfinite(limit).all():
+            assert np.isfinite(new_table).sum() < np.isfinite(old_table).sum()  # objects were left out
+            assert batch.static_candidates.size > 50
+        else:
+            assert np.array_equal(new_table, old_table)
