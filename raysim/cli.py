@@ -173,12 +173,17 @@ def _out_dir(args, scenario) -> Path:
     return args.out if args.out is not None else Path("runs") / scenario.name
 
 
+def _sensor_processes() -> int:
+    """Processes to render the sensors in (:func:`raysim.render.render`): 2 with two or more cores."""
+    return 2 if (os.cpu_count() or 1) >= 2 else 1
+
+
 def cmd_render(args) -> int:
     from raysim.render import render
 
     scenario = _load(args)
     result = render(scenario, _out_dir(args, scenario), progress=False if args.no_progress else None,
-                    formats=args.formats)
+                    formats=args.formats, sensor_processes=_sensor_processes())
     _summary(result)
     return 0
 
@@ -190,7 +195,8 @@ def cmd_run(args) -> int:
 
     scenario = _load(args)
     result, metrics = render_detect_evaluate(scenario, _out_dir(args, scenario),
-                                             progress=False if args.no_progress else None, formats=args.formats)
+                                             progress=False if args.no_progress else None, formats=args.formats,
+                                             sensor_processes=_sensor_processes())
     _summary(result)
     print(format_table(metrics))
     return 0

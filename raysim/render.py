@@ -26,6 +26,7 @@ from raysim.progress import stage
 from raysim.recording.jsonl import course_and_speed, write_ownship_chunk, write_truth_chunk
 from raysim.recording.staging import StagedDirectory, atomic_path
 from raysim.scenario import Scenario, scenario_to_yaml
+from raysim.sensor_process import SensorProcess, can_start
 from raysim.world import World
 
 TRUTH_RATE_HZ = 10.0  # docs/contracts.md: one truth line per object per 0.1 s
@@ -254,22 +255,38 @@ def _write_scenario_files(ctx: RenderContext, scenario: Scenario) -> None:
         ctx.counts[LAND] = write_land_geojson(scenario, land_ids, ctx.out_dir / LAND)
 
 
-def _render_sensors(ctx: RenderContext, scenario: Scenario, enabled, progress) -> tuple[list[str], list[str]]:
-    """Each enabled sensor's renderer (:data:`SENSOR_RENDERERS`) as a progress stage; (rendered, not available)."""
-    rendered, not_available = [], []
-    for name in enabled:
-        renderer = SENSOR_RENDERERS.get(name)
-        if renderer is None:
-            not_available.append(name)
-            continue
-        before = set(ctx.counts)
-        with stage(name, progress, _sensor_plan(scenario, name), bar=name != "ais") as step:  # AIS: no bar
-            renderer(ctx)
-            made = sorted(set(ctx.counts) - before)
-            step.done = ", ".join(f"{ctx.counts[k]} {k.split('/', 1)[-1]}" for k in made)
-        ctx.wall_time_s[name] = step.elapsed_s
-        rendered.append(name)
-    return rendered, not_available
+def _render_sensors(ctx: RenderContext, scenario: Scenario, enabled, progress,
+                    processes: int = 1) -> tuple[list[str], list[str]]:
+    """Each enabled sensor's renderer (:data:`SENSOR_RENDERERS`) as a progress stage; (rendered, not available).
+
+    With ``processes`` >= 2 (and another sensor to render beside it), the LiDAR renders in a second
+    process while this process renders the others (:mod:`raysim.sensor_process`): the same files.
+    """
+    names = [name for name in enabled if name in SENSOR_RENDERERS]
+    not_available = [name for name in enabled if name not in SENSOR_RENDERERS]
+    apart = "lidar" if processes >= 2 and "lidar" in names and len(names) > 1 and can_start() else None
+    child = SensorProcess(apart, SENSOR_RENDERERS[apart], ctx) if apart else None
+    wall: dict[str, float] = {}
+    try:
+        for name in names:
+            if name == apart:
+                continue
+            before = set(ctx.counts)
+            with stage(name, progress, _sensor_plan(scenario, name), bar=name != "ais") as step:  # AIS: no bar
+                SENSOR_RENDERERS[name](ctx)
+                made = sorted(set(ctx.counts) - before)
+                step.done = ", ".join(f"{ctx.counts[k]} {k.split('/', 1)[-1]}" for k in made)
+            wall[name] = step.elapsed_s
+        if child is not None:
+            with stage(apart, progress, _sensor_plan(scenario, apart) + ", in a second process") as step:
+                counts, wall[apart] = child.join()
+                ctx.counts.update(counts)
+                step.done = ", ".join(f"{counts[k]} {k.split('/', 1)[-1]}" for k in sorted(counts))
+    finally:
+        if child is not None:
+            child.stop()
+    ctx.wall_time_s.update((name, wall[name]) for name in names)  # in the sensors' order
+    return names, not_available
 
 
 def _manifest(scenario: Scenario, world: World, enabled, rendered: list[str], not_available: list[str], counts: dict,
@@ -294,7 +311,8 @@ def _manifest(scenario: Scenario, world: World, enabled, rendered: list[str], no
 
 def render(scenario: Scenario, out_dir: Path, progress: bool | None = None, formats: tuple[str, ...] = (),
            after_sensors: Callable[[Path], dict[str, int]] | None = None, own_ship_motion=None,
-           extra_counts: dict[str, int] | None = None, derived: bool = True) -> RenderResult:
+           extra_counts: dict[str, int] | None = None, derived: bool = True,
+           sensor_processes: int = 1) -> RenderResult:
     """Render ``scenario`` into ``out_dir``; all or nothing.
 
     Parameters
@@ -319,6 +337,9 @@ def render(scenario: Scenario, out_dir: Path, progress: bool | None = None, form
     derived : bool
         Write the files made from the recording's own (the bag, map.png, the bird's-eye views, the
         point-cloud files); False leaves them out (a recording for the TDM alone, as its tests use).
+    sensor_processes : int
+        2 or more: the LiDAR renders in a second process beside the other sensors (when this process
+        may have children; :mod:`raysim.sensor_process`), the same files; 1: one after another.
     """
     bars = progress_bars(progress)  # the stages' own tqdm bars
     started = time.perf_counter()
@@ -339,7 +360,7 @@ def render(scenario: Scenario, out_dir: Path, progress: bool | None = None, form
                 ctx.counts[f"{name}.jsonl"] = write(world, staged.path / f"{name}.jsonl", bars)
                 step.done = f"{ctx.counts[f'{name}.jsonl']} lines"
             wall[name] = step.elapsed_s
-        rendered, not_available = _render_sensors(ctx, scenario, enabled, progress)
+        rendered, not_available = _render_sensors(ctx, scenario, enabled, progress, sensor_processes)
 
         def manifest_now() -> dict:
             return _manifest(scenario, world, enabled, rendered, not_available, ctx.counts, wall)

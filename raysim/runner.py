@@ -16,7 +16,7 @@ __all__ = ["render_detect_evaluate"]
 
 
 def render_detect_evaluate(scenario: Scenario, out_dir: Path, progress: bool | None = None, formats: tuple[str, ...] = (),
-                           tdm_workers: int = 2) -> tuple[RenderResult, dict]:
+                           tdm_workers: int = 2, sensor_processes: int = 1) -> tuple[RenderResult, dict]:
     """Render ``scenario`` into ``out_dir``, then ``tdm run`` and ``tdm evaluate`` on it.
 
     Parameters
@@ -32,6 +32,8 @@ def render_detect_evaluate(scenario: Scenario, out_dir: Path, progress: bool | N
         Extra point-cloud files (:func:`raysim.render.render`).
     tdm_workers : int
         Front-end worker processes of the TDM (0: in this process, as inside a Dask task).
+    sensor_processes : int
+        Processes the sensors render in (:func:`raysim.render.render`; 1 inside a Dask task).
 
     Returns
     -------
@@ -58,5 +60,6 @@ def render_detect_evaluate(scenario: Scenario, out_dir: Path, progress: bool | N
         counts.update({f"tdm/warnings/{k}": v for k, v in result.warnings.items()})
         return counts
 
-    result = render(scenario, out_dir, progress=progress, formats=formats, after_sensors=detect_and_evaluate)
+    result = render(scenario, out_dir, progress=progress, formats=formats, after_sensors=detect_and_evaluate,
+                    sensor_processes=sensor_processes)
     return result, metrics
