@@ -173,7 +173,7 @@ def _out_dir(args, scenario) -> Path:
     return args.out if args.out is not None else Path("runs") / scenario.name
 
 
-def _sensor_processes() -> int:
+def _render_processes() -> int:
     """Processes to render the sensors in (:func:`raysim.render.render`): 2 with two or more cores."""
     return 2 if (os.cpu_count() or 1) >= 2 else 1
 
@@ -183,7 +183,7 @@ def cmd_render(args) -> int:
 
     scenario = _load(args)
     result = render(scenario, _out_dir(args, scenario), progress=False if args.no_progress else None,
-                    formats=args.formats, sensor_processes=_sensor_processes())
+                    formats=args.formats, processes=_render_processes())
     _summary(result)
     return 0
 
@@ -196,7 +196,7 @@ def cmd_run(args) -> int:
     scenario = _load(args)
     result, metrics = render_detect_evaluate(scenario, _out_dir(args, scenario),
                                              progress=False if args.no_progress else None, formats=args.formats,
-                                             sensor_processes=_sensor_processes())
+                                             processes=_render_processes())
     _summary(result)
     print(format_table(metrics))
     return 0
@@ -265,8 +265,10 @@ def summary_lines(out_dir: Path, manifest: dict) -> list[str]:
     m, out = manifest, Path(out_dir)
     wall = m["wall_time_s"]
     parts = {label: wall[key] for key, label in WALL_PARTS.items() if key in wall}
-    parts = {"render": wall["total"] - sum(parts.values()), **parts}
+    parts = {"render": wall.get("render", wall["total"] - sum(parts.values())), **parts}
     times = ", ".join(f"{label} {s:.1f} s" for label, s in parts.items())
+    if sum(parts.values()) > wall["total"] + 0.1 * len(parts):  # parts that ran side by side
+        times += "; the bag beside the evaluation and the pictures"
     written = sum(p.stat().st_size for p in out.rglob("*") if p.is_file())
     verb = "rendered, detected and evaluated" if "tdm" in wall else "rendered"
     lines = [f"{verb} {m['scenario']} ({m['duration_s']:g} s, seed {m['seed']}) into {out} in {wall['total']:.1f} s "

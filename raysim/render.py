@@ -7,6 +7,7 @@ succeeded. Sensors plug in through :data:`SENSOR_RENDERERS`.
 
 from __future__ import annotations
 
+import contextlib
 import datetime as dt
 import json
 import platform
@@ -26,7 +27,7 @@ from raysim.progress import stage
 from raysim.recording.jsonl import course_and_speed, write_ownship_chunk, write_truth_chunk
 from raysim.recording.staging import StagedDirectory, atomic_path
 from raysim.scenario import Scenario, scenario_to_yaml
-from raysim.sensor_process import SensorProcess, can_start
+from raysim.second_process import SecondProcess, can_start
 from raysim.world import World
 
 TRUTH_RATE_HZ = 10.0  # docs/contracts.md: one truth line per object per 0.1 s
@@ -209,21 +210,56 @@ def _sensor_plan(scenario: Scenario, name: str) -> str:
     return f"{duration_s:g} s of {'AIS traffic' if name == 'ais' else 'navigation NMEA'}"
 
 
-def _write_derived(ctx: RenderContext, scenario: Scenario, formats: tuple[str, ...], progress: bool | None) -> None:
+def write_bag(ctx: RenderContext) -> None:
+    """The staged recording's ROS 2 bag (:func:`raysim.recording.rosbag.write_rosbag`); messages a topic
+    in ``ctx.counts`` (``rosbag/<topic>``)."""
+    from raysim.recording.rosbag import write_rosbag
+
+    for topic, n in write_rosbag(ctx.out_dir, ctx.world.scenario).items():
+        ctx.counts[f"rosbag{topic}"] = n
+
+
+def _bag_done(counts: dict) -> str:
+    return f"{sum(v for k, v in counts.items() if k.startswith('rosbag/'))} messages"
+
+
+def _write_derived(ctx: RenderContext, scenario: Scenario, formats: tuple[str, ...], progress: bool | None,
+                   beside: Callable[[Path], None] | None = None, processes: int = 1) -> None:
     """The files made from the staged recording's own: the bag, the pictures, the point-cloud files.
 
     Each is a progress stage (:func:`raysim.progress.stage`) timed in ``ctx.wall_time_s``
-    (``rosbag``, ``pictures``, ``pointclouds``); their counts go to ``ctx.counts``.
+    (``rosbag``, ``pictures``, ``pointclouds``); their counts go to ``ctx.counts``. ``beside(staged
+    directory)`` (``raysim run``: the TDM's evaluation) runs first; with ``processes`` >= 2 the bag is
+    written in a second process meanwhile (:mod:`raysim.second_process`), and the pictures too.
     """
-    from raysim.recording.map_picture import write_map
-    from raysim.recording.rosbag import write_rosbag
+    wall: dict[str, float] = {}
+    with contextlib.ExitStack() as stages:
+        child = None
+        if processes >= 2 and can_start(scenario.duration_s):
+            child = SecondProcess("rosbag", write_bag, ctx)
+            stages.callback(child.stop)
+            bag_step = stages.enter_context(stage("rosbag", progress, "ROS 2 bag (MCAP), in a second process"))
+        if beside is not None:
+            beside(ctx.out_dir)
+        if child is None:
+            with stage("rosbag", progress, "ROS 2 bag (MCAP)") as step:
+                write_bag(ctx)
+                step.done = _bag_done(ctx.counts)
+            wall["rosbag"] = step.elapsed_s
+        wall.update(_write_pictures(ctx, scenario, formats, progress))
+        if child is not None:
+            counts, wall["rosbag"] = child.join()
+            ctx.counts.update(counts)
+            bag_step.done = _bag_done(counts)
+    ctx.wall_time_s.update((k, wall[k]) for k in ("rosbag", "pictures", "pointclouds") if k in wall)
 
-    staged, wall = ctx.out_dir, ctx.wall_time_s
-    with stage("rosbag", progress, "ROS 2 bag (MCAP)") as step:
-        for topic, n in write_rosbag(staged, scenario).items():
-            ctx.counts[f"rosbag{topic}"] = n
-        step.done = f"{sum(v for k, v in ctx.counts.items() if k.startswith('rosbag/'))} messages"
-    wall["rosbag"] = step.elapsed_s
+
+def _write_pictures(ctx: RenderContext, scenario: Scenario, formats: tuple[str, ...],
+                    progress: bool | None) -> dict[str, float]:
+    """map.png, the LiDAR's bird's-eye views and the point-cloud files ``formats``; their stages' wall times, s."""
+    from raysim.recording.map_picture import write_map
+
+    staged, wall = ctx.out_dir, {}
     lidar = (staged / "lidar" / "sweeps").is_dir()
     with stage("pictures", progress, "map.png" + (", LiDAR bird's-eye views" if lidar else "")) as step:
         write_map(staged, scenario.start_time)
@@ -242,6 +278,21 @@ def _write_derived(ctx: RenderContext, scenario: Scenario, formats: tuple[str, .
             ctx.counts.update(made)
             step.done = ", ".join(f"{n} {k}" for k, n in made.items())
         wall["pointclouds"] = step.elapsed_s
+    return wall
+
+
+
+
+def _timed_into(wall: dict[str, float], key: str, work: Callable[[Path], None] | None) -> Callable[[Path], None] | None:
+    """``work`` whose wall time, s, is added to ``wall[key]`` (None for None)."""
+    if work is None:
+        return None
+
+    def timed(path: Path) -> None:
+        started = time.perf_counter()
+        work(path)
+        wall[key] = wall.get(key, 0.0) + time.perf_counter() - started
+    return timed
 
 
 def _write_scenario_files(ctx: RenderContext, scenario: Scenario) -> None:
@@ -260,33 +311,39 @@ def _render_sensors(ctx: RenderContext, scenario: Scenario, enabled, progress,
     """Each enabled sensor's renderer (:data:`SENSOR_RENDERERS`) as a progress stage; (rendered, not available).
 
     With ``processes`` >= 2 (and another sensor to render beside it), the LiDAR renders in a second
-    process while this process renders the others (:mod:`raysim.sensor_process`): the same files.
+    process while this process renders the others (:mod:`raysim.second_process`): the same files. Its
+    stage starts with the process and ends when its files are all there.
     """
     names = [name for name in enabled if name in SENSOR_RENDERERS]
     not_available = [name for name in enabled if name not in SENSOR_RENDERERS]
-    apart = "lidar" if processes >= 2 and "lidar" in names and len(names) > 1 and can_start() else None
-    child = SensorProcess(apart, SENSOR_RENDERERS[apart], ctx) if apart else None
+    apart = "lidar" if processes >= 2 and "lidar" in names and len(names) > 1 \
+        and can_start(scenario.duration_s) else None
     wall: dict[str, float] = {}
-    try:
+    with contextlib.ExitStack() as stages:
+        child = None
+        if apart is not None:
+            child = SecondProcess(apart, SENSOR_RENDERERS[apart], ctx)
+            stages.callback(child.stop)
+            apart_step = stages.enter_context(stage(apart, progress, _sensor_plan(scenario, apart) + ", in a second process"))
         for name in names:
             if name == apart:
                 continue
             before = set(ctx.counts)
             with stage(name, progress, _sensor_plan(scenario, name), bar=name != "ais") as step:  # AIS: no bar
                 SENSOR_RENDERERS[name](ctx)
-                made = sorted(set(ctx.counts) - before)
-                step.done = ", ".join(f"{ctx.counts[k]} {k.split('/', 1)[-1]}" for k in made)
+                step.done = _made(ctx.counts, sorted(set(ctx.counts) - before))
             wall[name] = step.elapsed_s
         if child is not None:
-            with stage(apart, progress, _sensor_plan(scenario, apart) + ", in a second process") as step:
-                counts, wall[apart] = child.join()
-                ctx.counts.update(counts)
-                step.done = ", ".join(f"{counts[k]} {k.split('/', 1)[-1]}" for k in sorted(counts))
-    finally:
-        if child is not None:
-            child.stop()
+            counts, wall[apart] = child.join()
+            ctx.counts.update(counts)
+            apart_step.done = _made(counts, sorted(counts))
     ctx.wall_time_s.update((name, wall[name]) for name in names)  # in the sensors' order
     return names, not_available
+
+
+def _made(counts: dict, keys: list[str]) -> str:
+    """What a stage made, for its end line: ``"<count> <file>"`` of each of ``keys``."""
+    return ", ".join(f"{counts[k]} {k.split('/', 1)[-1]}" for k in keys)
 
 
 def _manifest(scenario: Scenario, world: World, enabled, rendered: list[str], not_available: list[str], counts: dict,
@@ -312,7 +369,7 @@ def _manifest(scenario: Scenario, world: World, enabled, rendered: list[str], no
 def render(scenario: Scenario, out_dir: Path, progress: bool | None = None, formats: tuple[str, ...] = (),
            after_sensors: Callable[[Path], dict[str, int]] | None = None, own_ship_motion=None,
            extra_counts: dict[str, int] | None = None, derived: bool = True,
-           sensor_processes: int = 1) -> RenderResult:
+           beside_derived: Callable[[Path], None] | None = None, processes: int = 1) -> RenderResult:
     """Render ``scenario`` into ``out_dir``; all or nothing.
 
     Parameters
@@ -337,9 +394,14 @@ def render(scenario: Scenario, out_dir: Path, progress: bool | None = None, form
     derived : bool
         Write the files made from the recording's own (the bag, map.png, the bird's-eye views, the
         point-cloud files); False leaves them out (a recording for the TDM alone, as its tests use).
-    sensor_processes : int
-        2 or more: the LiDAR renders in a second process beside the other sensors (when this process
-        may have children; :mod:`raysim.sensor_process`), the same files; 1: one after another.
+    beside_derived : callable, optional
+        Called with the staged recording directory after ``after_sensors``, before the derived files
+        (``raysim run``: the TDM's evaluation); with ``processes`` >= 2 the bag is written meanwhile in a
+        second process. Its wall time is added to ``tdm``'s. An error in it leaves nothing on disk.
+    processes : int
+        2 or more: the LiDAR renders in a second process beside the other sensors, and the bag is written
+        in one beside ``beside_derived`` and the pictures (when this process may have children;
+        :mod:`raysim.second_process`), the same files; 1: one after another.
     """
     bars = progress_bars(progress)  # the stages' own tqdm bars
     started = time.perf_counter()
@@ -360,7 +422,8 @@ def render(scenario: Scenario, out_dir: Path, progress: bool | None = None, form
                 ctx.counts[f"{name}.jsonl"] = write(world, staged.path / f"{name}.jsonl", bars)
                 step.done = f"{ctx.counts[f'{name}.jsonl']} lines"
             wall[name] = step.elapsed_s
-        rendered, not_available = _render_sensors(ctx, scenario, enabled, progress, sensor_processes)
+        rendered, not_available = _render_sensors(ctx, scenario, enabled, progress, processes)
+        wall["render"] = time.perf_counter() - started  # world, truth, navigation and sensors
 
         def manifest_now() -> dict:
             return _manifest(scenario, world, enabled, rendered, not_available, ctx.counts, wall)
@@ -371,8 +434,11 @@ def render(scenario: Scenario, out_dir: Path, progress: bool | None = None, form
             t0 = time.perf_counter()
             ctx.counts.update(after_sensors(staged.path))
             wall["tdm"] = time.perf_counter() - t0
+        beside = _timed_into(wall, "tdm", beside_derived)
         if derived:
-            _write_derived(ctx, scenario, formats, progress)
+            _write_derived(ctx, scenario, formats, progress, beside, processes)
+        elif beside is not None:
+            beside(staged.path)
         wall["total"] = time.perf_counter() - started
         manifest = manifest_now()
         with atomic_path(staged.path / MANIFEST) as tmp:

@@ -2,11 +2,13 @@
 
 ``raysim run`` and each run of ``raysim batch`` call :func:`render_detect_evaluate`; the TDM runs
 inside the staged directory (:func:`raysim.render.render`'s ``after_sensors``), so its targets
-join the bag and the recording still appears whole or not at all.
+join the bag and the recording still appears whole or not at all; its evaluation runs while the bag
+is written (``beside_derived``).
 """
 
 from __future__ import annotations
 
+import contextlib
 from pathlib import Path
 
 from raysim.render import RenderResult, render
@@ -16,7 +18,7 @@ __all__ = ["render_detect_evaluate"]
 
 
 def render_detect_evaluate(scenario: Scenario, out_dir: Path, progress: bool | None = None, formats: tuple[str, ...] = (),
-                           tdm_workers: int = 2, sensor_processes: int = 1) -> tuple[RenderResult, dict]:
+                           tdm_workers: int = 2, processes: int = 1) -> tuple[RenderResult, dict]:
     """Render ``scenario`` into ``out_dir``, then ``tdm run`` and ``tdm evaluate`` on it.
 
     Parameters
@@ -32,7 +34,7 @@ def render_detect_evaluate(scenario: Scenario, out_dir: Path, progress: bool | N
         Extra point-cloud files (:func:`raysim.render.render`).
     tdm_workers : int
         Front-end worker processes of the TDM (0: in this process, as inside a Dask task).
-    sensor_processes : int
+    processes : int
         Processes the sensors render in (:func:`raysim.render.render`; 1 inside a Dask task).
 
     Returns
@@ -43,23 +45,34 @@ def render_detect_evaluate(scenario: Scenario, out_dir: Path, progress: bool | N
     """
     from raysim.progress import bars, stage
     from tdm.cli import evaluate_command, run_command
-    from tdm.errors import RecordingError
 
     metrics: dict = {}
 
-    def detect_and_evaluate(staged: Path) -> dict[str, int]:
-        try:
+    def detect(staged: Path) -> dict[str, int]:
+        with _fresh_recording():
             with stage("tdm run", progress, "detect and track targets", bar=True) as step:
                 result = run_command(staged, workers=tdm_workers, progress=bars(progress))
                 step.done = f"{result.n_targets} targets over {result.n_epochs} epochs"
-            with stage("tdm evaluate", progress, "metrics against truth, plots") as step:
-                metrics.update(evaluate_command(staged))
-        except RecordingError as exc:  # the recording was just written: this is a bug, not bad input
-            raise RuntimeError(f"tdm failed on the fresh recording: {exc}") from exc
         counts = {"tdm/detected_targets.jsonl": result.n_target_lines, "tdm/targets": result.n_targets}
         counts.update({f"tdm/warnings/{k}": v for k, v in result.warnings.items()})
         return counts
 
-    result = render(scenario, out_dir, progress=progress, formats=formats, after_sensors=detect_and_evaluate,
-                    sensor_processes=sensor_processes)
+    def evaluate(staged: Path) -> None:
+        with _fresh_recording():
+            with stage("tdm evaluate", progress, "metrics against truth, plots"):
+                metrics.update(evaluate_command(staged))
+
+    result = render(scenario, out_dir, progress=progress, formats=formats, after_sensors=detect,
+                    beside_derived=evaluate, processes=processes)
     return result, metrics
+
+
+@contextlib.contextmanager
+def _fresh_recording():
+    """The TDM on the recording just written: a RecordingError there is a bug, not bad input."""
+    from tdm.errors import RecordingError
+
+    try:
+        yield
+    except RecordingError as exc:
+        raise RuntimeError(f"tdm failed on the fresh recording: {exc}") from exc

@@ -1,0 +1,107 @@
+"""Work of a render done in a second process while this process does other work.
+
+Each renderer and writer runs on one core, and a render has two pieces of work that take long and
+share nothing: the LiDAR and the other sensors (on busy_open_sea the LiDAR takes about as long as
+the radar, AIS and navigation together; benchmarks/results/lidar.md, radar.md), and, once the TDM
+has run, the ROS 2 bag and the TDM's evaluation and the pictures. On a machine with two or more
+cores, :func:`raysim.render.render` (``processes=2``, as ``raysim run`` and ``raysim render`` call
+it, for a scenario of at least :data:`MIN_SCENARIO_S`) starts a child process for the LiDAR while it renders the other sensors, and one for the bag
+while it evaluates and draws. Each sensor draws only on its own named random streams
+(:mod:`raysim.random_streams`) and every piece writes only its own files, so the recording is the
+same bytes as when everything runs one after another (tests/raysim/test_second_process.py).
+
+The child is *spawned* (a fresh interpreter that gets the render's context by pickle), not forked:
+a process that has cast rays before holds Embree's thread pool, which does not survive a fork (the
+forked child hangs in its first cast). What the child made (its counts and wall time) comes back
+through a pipe; an error in it is raised again here, and the staged directory is then removed as
+for any error (nothing partial on disk). A child still running when the parent fails is terminated.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import multiprocessing
+import time
+from typing import Callable
+
+__all__ = ["MIN_SCENARIO_S", "SecondProcess", "can_start"]
+
+
+#: Shortest scenario given second processes, s: a spawned child takes 1-2 s to start (a fresh interpreter
+#: importing numpy and Open3D, and the world by pickle), more than a shorter render's LiDAR or bag saves.
+MIN_SCENARIO_S = 30.0
+
+
+def can_start(duration_s: float) -> bool:
+    """Whether a render of ``duration_s`` s of scenario gains from a second process here: at least
+    :data:`MIN_SCENARIO_S` long, and this process may have children (a daemonic process, such as a Dask
+    worker's, may not)."""
+    return duration_s >= MIN_SCENARIO_S and not multiprocessing.current_process().daemon
+
+
+class SecondProcess:
+    """A renderer or writer running in a spawned child.
+
+    Parameters
+    ----------
+    name : str
+        What it makes (for messages).
+    renderer : callable
+        ``renderer(ctx)``, which records what it made in ``ctx.counts`` (:data:`raysim.render.SENSOR_RENDERERS`,
+        :func:`raysim.render.write_bag`): a module-level function (it is pickled by name).
+    ctx : raysim.render.RenderContext
+        The render's context; the child works on a copy (pickled) without progress bars and with no
+        ray engine (it builds its own).
+    """
+
+    def __init__(self, name: str, renderer: Callable, ctx):
+        spawn = multiprocessing.get_context("spawn")
+        self.name = name
+        self._receive, send = spawn.Pipe(duplex=False)
+        child_ctx = dataclasses.replace(ctx, progress=False, counts={}, wall_time_s={}, _scene=None)
+        self._process = spawn.Process(target=_run, args=(renderer, child_ctx, send), name=f"raysim-{name}")
+        self._process.start()
+        send.close()
+
+    def join(self) -> tuple[dict, float]:
+        """Wait for the child: the counts it made and its renderer's wall time, s.
+
+        Raises
+        ------
+        Exception
+            The child's own error, or RuntimeError when it ended without a word (killed).
+        """
+        try:
+            kind, payload = self._receive.recv()
+        except EOFError:
+            kind, payload = "died", None
+        finally:
+            self._receive.close()
+            self._process.join()
+        if kind == "died":
+            raise RuntimeError(f"the {self.name} process ended with exit code {self._process.exitcode}")
+        if kind == "error":
+            raise payload
+        return payload
+
+    def stop(self) -> None:
+        """Terminate the child if it still runs (the parent failed)."""
+        if self._process.is_alive():
+            self._process.terminate()
+            self._process.join()
+
+
+def _run(renderer: Callable, ctx, send) -> None:
+    """The child: render, then send ("ok", (counts, wall time s)) or ("error", exception)."""
+    started = time.perf_counter()
+    try:
+        renderer(ctx)
+        message = ("ok", (dict(ctx.counts), time.perf_counter() - started))
+    except BaseException as exc:  # noqa: BLE001 - every failure goes back to the parent
+        message = ("error", exc)
+    try:
+        send.send(message)
+    except Exception as exc:  # an exception that does not pickle: its text
+        send.send(("error", RuntimeError(f"{type(message[1]).__name__}: {message[1]} ({exc})")))
+    finally:
+        send.close()
