@@ -372,6 +372,17 @@ COMMANDS = {"render": cmd_render, "run": cmd_run, "batch": cmd_batch, "import-hi
             "bench": cmd_bench, "rcs": cmd_rcs, "live": cmd_live}
 
 
+def _after_interrupt(exc: BaseException) -> bool:
+    """Whether ``exc`` came of a Ctrl-C: a KeyboardInterrupt among its causes and contexts."""
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt):
+            return True
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return False
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``raysim`` console script.
 
@@ -390,6 +401,8 @@ def main(argv: list[str] | None = None) -> int:
             except Exception as exc:
                 if sigterm.received:  # SIGTERM surfaced as another exception (from a C extension)
                     raise Terminated() from exc
+                if _after_interrupt(exc):  # Ctrl-C surfaced so (Open3D's import: "initialization failed")
+                    raise KeyboardInterrupt() from exc
                 raise
     except (InputError, OSError, KeyboardInterrupt) as exc:  # bad input, a write fault, an interrupt: one line
         code = report_fault(exc, getattr(args, "out", None), bad_input=InputError)

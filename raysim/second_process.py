@@ -19,8 +19,12 @@ for any error (nothing partial on disk). A child still running when the parent f
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import multiprocessing
+import os
+import signal
+import threading
 import time
 from typing import Callable
 
@@ -57,11 +61,16 @@ class SecondProcess:
     def __init__(self, name: str, renderer: Callable, ctx):
         spawn = multiprocessing.get_context("spawn")
         self.name = name
-        self._receive, send = spawn.Pipe(duplex=False)
-        child_ctx = dataclasses.replace(ctx, progress=False, counts={}, wall_time_s={}, _scene=None)
-        self._process = spawn.Process(target=_run, args=(renderer, child_ctx, send), name=f"raysim-{name}")
-        self._process.start()
-        send.close()
+        self._pipe, child_end = spawn.Pipe(duplex=True)
+        self._process = spawn.Process(target=_run, args=(renderer, child_end), name=f"raysim-{name}")
+        with _interrupts_ignored():  # inherited: Ctrl-C reaches the parent alone, which stops the child
+            self._process.start()
+        child_end.close()
+        try:  # the context goes down the pipe: a parent stopped half-way leaves the child a quiet end
+            self._pipe.send(dataclasses.replace(ctx, progress=False, counts={}, wall_time_s={}, _scene=None))
+        except BaseException:
+            self.stop()
+            raise
 
     def join(self) -> tuple[dict, float]:
         """Wait for the child: the counts it made and its renderer's wall time, s.
@@ -72,11 +81,11 @@ class SecondProcess:
             The child's own error, or RuntimeError when it ended without a word (killed).
         """
         try:
-            kind, payload = self._receive.recv()
+            kind, payload = self._pipe.recv()
         except EOFError:
             kind, payload = "died", None
         finally:
-            self._receive.close()
+            self._pipe.close()
             self._process.join()
         if kind == "died":
             raise RuntimeError(f"the {self.name} process ended with exit code {self._process.exitcode}")
@@ -91,8 +100,29 @@ class SecondProcess:
             self._process.join()
 
 
-def _run(renderer: Callable, ctx, send) -> None:
-    """The child: render, then send ("ok", (counts, wall time s)) or ("error", exception)."""
+@contextlib.contextmanager
+def _interrupts_ignored():
+    """SIGINT ignored while a child starts, so that the child ignores it for good (a disposition to
+    ignore survives exec, and Python then installs no KeyboardInterrupt handler): Ctrl-C, which a
+    terminal sends to the whole process group, interrupts the parent, whose clean-up stops the child,
+    and no child prints a traceback. Only in the main thread (where signals can be set)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _run(renderer: Callable, pipe) -> None:
+    """The child: the context from the pipe, render, then send back ("ok", (counts, wall time s)) or
+    ("error", exception). A parent gone (stopped, killed) ends it quietly."""
+    try:
+        ctx = pipe.recv()
+    except BaseException:  # noqa: BLE001 - the parent is gone: nothing to say, no one to say it to
+        os._exit(1)
     started = time.perf_counter()
     try:
         renderer(ctx)
@@ -100,8 +130,11 @@ def _run(renderer: Callable, ctx, send) -> None:
     except BaseException as exc:  # noqa: BLE001 - every failure goes back to the parent
         message = ("error", exc)
     try:
-        send.send(message)
-    except Exception as exc:  # an exception that does not pickle: its text
-        send.send(("error", RuntimeError(f"{type(message[1]).__name__}: {message[1]} ({exc})")))
+        pipe.send(message)
+    except BaseException as exc:  # noqa: BLE001 - an exception that does not pickle: its text
+        try:
+            pipe.send(("error", RuntimeError(f"{type(message[1]).__name__}: {message[1]} ({exc})")))
+        except BaseException:  # noqa: BLE001 - the parent is gone
+            os._exit(1)
     finally:
-        send.close()
+        pipe.close()

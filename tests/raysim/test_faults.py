@@ -144,3 +144,20 @@ def test_sigterm_that_an_extension_turns_into_another_exception_still_exits_143(
     assert signal.getsignal(signal.SIGTERM) == previous
     captured = capsys.readouterr()
     assert captured.err.splitlines() == ["error: terminated; nothing was written"] and captured.out == ""
+
+
+def test_ctrl_c_that_an_extension_turns_into_another_exception_still_exits_130(tmp_path, monkeypatch, capsys):
+    """Ctrl-C landing in open3d's module initialisation comes out as ImportError from KeyboardInterrupt (seen
+    when a terminal's Ctrl-C arrived as the radar renderer imported Open3D): still one line and code 130."""
+    import raysim.render
+
+    def render_hit_in_an_import(*args, **kwargs):
+        try:
+            raise KeyboardInterrupt
+        except KeyboardInterrupt as exc:
+            raise ImportError("initialization failed") from exc
+
+    monkeypatch.setattr(raysim.render, "render", render_hit_in_an_import)
+    assert main(["render", str(BUSY), "-o", str(tmp_path / "rec"), "--no-progress"]) == 130
+    captured = capsys.readouterr()
+    assert captured.err.splitlines() == ["error: interrupted; nothing was written"] and captured.out == ""
