@@ -230,9 +230,9 @@ class Staging:
             shutil.rmtree(self.root, ignore_errors=True)
             self.path.mkdir(parents=True)
             (self.root / HOST_MARKER).write_text(socket.gethostname() + "\n", encoding="utf-8")
-        except OSError as exc:
+        except BaseException as exc:  # a write fault, or Ctrl-C / SIGTERM just after the directory was made
             shutil.rmtree(self.root, ignore_errors=True)
-            if is_write_fault(exc):
+            if isinstance(exc, OSError) and is_write_fault(exc):
                 raise write_fault(exc, self.final) from exc
             raise
         return self

@@ -161,3 +161,24 @@ def test_ctrl_c_that_an_extension_turns_into_another_exception_still_exits_130(t
     assert main(["render", str(BUSY), "-o", str(tmp_path / "rec"), "--no-progress"]) == 130
     captured = capsys.readouterr()
     assert captured.err.splitlines() == ["error: interrupted; nothing was written"] and captured.out == ""
+
+
+def test_an_interrupt_just_after_the_staging_directory_is_made_leaves_nothing(tmp_path, monkeypatch):
+    """Ctrl-C between the staging directory's creation and its host marker (seen when a signal followed the
+    directory's appearance at once): the directory goes, as for any interrupt later."""
+    from pathlib import Path
+
+    from groundfloor.staging import HOST_MARKER, Staging
+
+    written = Path.write_text
+
+    def interrupted(self, *args, **kwargs):
+        if self.name == HOST_MARKER:
+            raise KeyboardInterrupt
+        return written(self, *args, **kwargs)
+
+    monkeypatch.setattr(Path, "write_text", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        with Staging(tmp_path / "out"):
+            pass
+    assert list(tmp_path.iterdir()) == []
