@@ -1,12 +1,13 @@
 """The front ends' worker pool of ``tdm run``: scans in, detections out, in time order.
 
-Scans are independent, so their front ends (:func:`tdm.frontend.lidar.lidar_detections`,
+Scans are independent, so their front ends (:func:`tdm.frontend.lidar.lidar_detections_batch`,
 :func:`tdm.frontend.radar.radar_detections`, then the chart's land mask, :mod:`tdm.land`) run in a
-pool of worker processes. Each worker gets
-the own-ship track, the mounts and the front ends' settings once (:func:`_init_worker`); a job is a
-sweep file to read (checked in the worker) or a sweep already read (the PCAP's). Results come back
-in submission order and pass a reorder buffer that puts them in exact end-time order
-(:func:`detections_in_time_order`).
+pool of worker processes. Each worker gets the own-ship track, the mounts and the front ends' settings
+once (:func:`_init_worker`); a job is a sweep file to read (checked in the worker) or a sweep already
+read (the PCAP's). Jobs go in chunks of :data:`BATCH_SCANS` (in this process too, without workers;
+live mode takes chunks of one scan), and a chunk's LiDAR sweeps go through their front end together,
+each with the result it has alone (:func:`_frontend_chunk`). Results come back in submission order and
+pass a reorder buffer that puts them in exact end-time order (:func:`detections_in_time_order`).
 """
 
 from __future__ import annotations
