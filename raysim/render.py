@@ -14,7 +14,7 @@ import platform
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable
+from typing import Callable, Iterator
 
 import numpy as np
 from tqdm import tqdm
@@ -233,24 +233,19 @@ def _write_derived(ctx: RenderContext, scenario: Scenario, formats: tuple[str, .
     written in a second process meanwhile (:mod:`raysim.second_process`), and the pictures too.
     """
     wall: dict[str, float] = {}
-    with contextlib.ExitStack() as stages:
-        child = None
-        if processes >= 2 and can_start(scenario.duration_s):
-            child = SecondProcess("rosbag", write_bag, ctx)
-            stages.callback(child.stop)
-            bag_step = stages.enter_context(stage("rosbag", progress, "ROS 2 bag (MCAP), in a second process"))
+    apart = _second_process_wanted(processes, scenario)
+    with (_in_second_process("rosbag", write_bag, ctx, progress, "ROS 2 bag (MCAP), in a second process", _bag_done)
+          if apart else contextlib.nullcontext({})) as bag:
         if beside is not None:
             beside(ctx.out_dir)
-        if child is None:
+        if not apart:
             with stage("rosbag", progress, "ROS 2 bag (MCAP)") as step:
                 write_bag(ctx)
                 step.done = _bag_done(ctx.counts)
             wall["rosbag"] = step.elapsed_s
         wall.update(_write_pictures(ctx, scenario, formats, progress))
-        if child is not None:
-            counts, wall["rosbag"] = child.join()
-            ctx.counts.update(counts)
-            bag_step.done = _bag_done(counts)
+    if apart:
+        wall["rosbag"] = bag["wall_s"]
     ctx.wall_time_s.update((k, wall[k]) for k in ("rosbag", "pictures", "pointclouds") if k in wall)
 
 
@@ -316,15 +311,11 @@ def _render_sensors(ctx: RenderContext, scenario: Scenario, enabled, progress,
     """
     names = [name for name in enabled if name in SENSOR_RENDERERS]
     not_available = [name for name in enabled if name not in SENSOR_RENDERERS]
-    apart = "lidar" if processes >= 2 and "lidar" in names and len(names) > 1 \
-        and can_start(scenario.duration_s) else None
+    apart = "lidar" if "lidar" in names and len(names) > 1 and _second_process_wanted(processes, scenario) else None
     wall: dict[str, float] = {}
-    with contextlib.ExitStack() as stages:
-        child = None
-        if apart is not None:
-            child = SecondProcess(apart, SENSOR_RENDERERS[apart], ctx)
-            stages.callback(child.stop)
-            apart_step = stages.enter_context(stage(apart, progress, _sensor_plan(scenario, apart) + ", in a second process"))
+    with (_in_second_process(apart, SENSOR_RENDERERS[apart], ctx, progress,
+                             _sensor_plan(scenario, apart) + ", in a second process", lambda c: _made(c, sorted(c)))
+          if apart else contextlib.nullcontext({})) as lidar:
         for name in names:
             if name == apart:
                 continue
@@ -333,12 +324,34 @@ def _render_sensors(ctx: RenderContext, scenario: Scenario, enabled, progress,
                 SENSOR_RENDERERS[name](ctx)
                 step.done = _made(ctx.counts, sorted(set(ctx.counts) - before))
             wall[name] = step.elapsed_s
-        if child is not None:
-            counts, wall[apart] = child.join()
-            ctx.counts.update(counts)
-            apart_step.done = _made(counts, sorted(counts))
+    if apart:
+        wall[apart] = lidar["wall_s"]
     ctx.wall_time_s.update((name, wall[name]) for name in names)  # in the sensors' order
     return names, not_available
+
+
+def _second_process_wanted(processes: int, scenario: Scenario) -> bool:
+    """Whether a render asked for ``processes`` gets a second process (:func:`raysim.second_process.can_start`)."""
+    return processes >= 2 and can_start(scenario.duration_s)
+
+
+@contextlib.contextmanager
+def _in_second_process(name: str, renderer: Callable, ctx: RenderContext, progress: bool | None, what: str,
+                       done: Callable[[dict], str]) -> Iterator[dict]:
+    """``renderer(ctx)`` in a second process (:class:`raysim.second_process.SecondProcess`) while the block
+    runs, as the progress stage ``name``, which starts with the process and ends when it has finished; its
+    counts join ``ctx.counts`` and the dict yielded gets ``"wall_s"``, the renderer's own wall time. The
+    process is stopped if the block fails."""
+    child = SecondProcess(name, renderer, ctx)
+    try:
+        with stage(name, progress, what) as step:
+            timing: dict = {}
+            yield timing
+            counts, timing["wall_s"] = child.join()
+            ctx.counts.update(counts)
+            step.done = done(counts)
+    finally:
+        child.stop()
 
 
 def _made(counts: dict, keys: list[str]) -> str:

@@ -21,7 +21,7 @@ from typing import Iterable, Iterator
 import numpy as np
 
 from tdm.detections import Detections, ReadStats
-from tdm.frontend.lidar import lidar_detections_batch
+from tdm.frontend.lidar import LIDAR_FIELDS, lidar_detections_batch
 from tdm.frontend.radar import radar_detections
 from tdm.frontend.radar_sidelobes import drop_sidelobes
 from tdm.land import drop_on_land
@@ -31,7 +31,6 @@ from tdm.recording.sweeps import SCHEMAS, read_sweep, unreadable_warning
 
 __all__ = ["BATCH_SCANS", "LIDAR_FIELDS", "RADAR_FIELDS", "detections_in_time_order"]
 
-LIDAR_FIELDS = ("x", "y", "z", "ring", "time")  # what the LiDAR front end reads
 RADAR_FIELDS = ("echo", "azimuth_deg", "heading_deg", "time", "range_m")
 
 #: Scans per chunk, a worker task: enough to hide the inter-process overhead (about a millisecond a task)

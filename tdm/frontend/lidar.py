@@ -103,11 +103,11 @@ from tdm.frontend.lidar_config import (HDL32E_FIRING_CYCLE_S, LINK_WINDOW_CYCLES
 from tdm.frontend.lidar_graph import components, range_image_links, voxel_grid, voxel_pairs
 from tdm.land import LandMask
 
-__all__ = ["HDL32E_FIRING_CYCLE_S", "LINK_WINDOW_CYCLES", "LidarFrontEndConfig", "lidar_clusters", "lidar_clusters_batch",
-           "lidar_detections", "lidar_detections_batch", "lidar_mount_from_scenario"]
+__all__ = ["HDL32E_FIRING_CYCLE_S", "LIDAR_FIELDS", "LINK_WINDOW_CYCLES", "LidarFrontEndConfig", "lidar_clusters",
+           "lidar_clusters_batch", "lidar_detections", "lidar_detections_batch", "lidar_mount_from_scenario"]
 
-#: The sweep arrays the front end reads.
-_FIELDS = ("x", "y", "z", "ring", "time")
+#: The sweep arrays the front end reads (what ``tdm run`` loads of a LiDAR sweep file).
+LIDAR_FIELDS = ("x", "y", "z", "ring", "time")
 #: Variance of a uniform distribution over a width w: w^2 / 12 (footprint box, azimuth step).
 UNIFORM_VARIANCE_DIVISOR = 12.0
 #: Variance per axis of a uniform disc of diameter d: d^2 / 16 (beam divergence).
@@ -201,7 +201,7 @@ def lidar_clusters_batch(sweeps: list[dict[str, np.ndarray]], track: OwnshipTrac
         For each sweep, what :func:`lidar_clusters` returns.
     """
     config = config or LidarFrontEndConfig()
-    if len({tuple(np.asarray(s[k]).dtype.str for k in _FIELDS) for s in sweeps}) > 1:  # the arithmetic differs
+    if len({tuple(np.asarray(s[k]).dtype.str for k in LIDAR_FIELDS) for s in sweeps}) > 1:  # the arithmetic differs
         return [lidar_clusters_batch([s], track, mount, config, land)[0] for s in sweeps]
     times = [np.asarray(s["time"], dtype=np.float64) for s in sweeps]
     scan_time_s = np.array([float(t.min()) if t.size else math.nan for t in times])
