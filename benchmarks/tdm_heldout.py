@@ -67,7 +67,8 @@ CRITERIA = (
 
 
 def closest_approach_m(recording: Path) -> dict[str, float]:
-    """Per truth object (by name): its closest distance to the own ship over the run, m (truth.jsonl)."""
+    """Per truth object (by name): its centre's closest distance to the own ship over the run, m (truth.jsonl; the
+    body origin in a recording from before truth carried the centre)."""
     own: dict[float, tuple[float, float]] = {}
     rows: list[tuple[str, float, float, float]] = []
     with open(recording / "truth.jsonl", encoding="utf-8") as f:
@@ -76,7 +77,7 @@ def closest_approach_m(recording: Path) -> dict[str, float]:
             if row["kind"] == "ownship":
                 own[row["t"]] = (row["x"], row["y"])
             else:
-                rows.append((row["name"], row["t"], row["x"], row["y"]))
+                rows.append((row["name"], row["t"], row.get("centre_x", row["x"]), row.get("centre_y", row["y"])))
     closest: dict[str, float] = {}
     for name, t, x, y in rows:
         ox, oy = own[t]

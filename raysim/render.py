@@ -24,7 +24,7 @@ from raysim import __version__, schema
 from raysim.pose import heading_deg_from_yaw
 from raysim.progress import bars as progress_bars
 from raysim.progress import stage
-from raysim.recording.jsonl import course_and_speed, write_ownship_chunk, write_truth_chunk
+from raysim.recording.jsonl import centre_positions_m, course_and_speed, write_ownship_chunk, write_truth_chunk
 from raysim.recording.staging import StagedDirectory, atomic_path
 from raysim.scenario import Scenario, scenario_to_yaml
 from raysim.second_process import SecondProcess, can_start
@@ -115,11 +115,14 @@ def write_truth(world: World, path: Path, progress: bool) -> int:
                     continue
                 poses = o.motion.poses(t)
                 lat, lon = world.frame.to_geodetic(poses.position_m[:, 0], poses.position_m[:, 1])
+                centre_x, centre_y = centre_positions_m(poses.position_m, poses.yaw_rad, o.centre_body_m)
+                centre_lat, centre_lon = world.frame.to_geodetic(centre_x, centre_y)
                 cog, sog = course_and_speed(o.motion.velocity_mps(t), poses.yaw_rad)
                 per_object.append(dict(
                     id=o.object_id, name=o.name, kind=o.kind, length_m=o.length_m, beam_m=o.beam_m, height_m=o.height_m,
                     ais=bool(o.ais is not None and o.ais.enabled), mmsi=o.ais.mmsi if o.ais is not None else None,
                     lat=lat, lon=lon, x=poses.position_m[:, 0], y=poses.position_m[:, 1],
+                    centre_lat=centre_lat, centre_lon=centre_lon, centre_x=centre_x, centre_y=centre_y,
                     heading_deg=heading_deg_from_yaw(poses.yaw_rad), cog_deg=cog, sog_mps=sog,
                 ))
             lines += write_truth_chunk(handle, t, per_object)

@@ -47,6 +47,10 @@ class WorldObject:
         Transponder configuration, if any.
     key_path : str
         Where the object is in the scenario file (for messages).
+    centre_body_m : tuple of float
+        Centre of the above-water extents in the body frame (x, y), m
+        (:meth:`raysim.meshes.BodyMesh.centre_above_water_m`): where the length x beam box of truth
+        stands, and the point truth.jsonl reports as the object's centre.
     """
 
     object_id: int
@@ -59,6 +63,7 @@ class WorldObject:
     height_m: float
     ais: ShipAis | None
     key_path: str
+    centre_body_m: tuple[float, float] = (0.0, 0.0)
 
 
 class World:
@@ -152,7 +157,8 @@ class World:
         else:
             mesh = meshes.own_ship(own.length_m, own.beam_m)
         length, beam, height = mesh.extents_above_water_m()
-        return WorldObject(0, own.name, "ownship", mesh, ShipMotion(track, waves), length, beam, height, None, "own_ship")
+        return WorldObject(0, own.name, "ownship", mesh, ShipMotion(track, waves), length, beam, height, None, "own_ship",
+                           mesh.centre_above_water_m())
 
     def _csv_track(self, path: Path) -> tuple[SampledTrack, bool]:
         """The trajectory file resampled on the track grid, and whether it carries roll/pitch/heave."""
@@ -182,7 +188,8 @@ class World:
         else:
             mesh = self._load(o.mesh, o.material, where + ".mesh")
         length, beam, height = mesh.extents_above_water_m()
-        return WorldObject(object_id, o.name, o.kind, mesh, motion, length, beam, height, None, where)
+        return WorldObject(object_id, o.name, o.kind, mesh, motion, length, beam, height, None, where,
+                           mesh.centre_above_water_m())
 
     def _land(self, first_id: int) -> list[WorldObject]:
         """The ``land`` entries, one object each (kind ``land``), standing at the origin in the local frame."""
@@ -212,5 +219,6 @@ class World:
             mesh = self._mesh_cache[key]
             _, _, height = mesh.extents_above_water_m()
             length, beam = ship.length_m, ship.beam_m
-        return WorldObject(object_id, ship.name, "ship", mesh, ShipMotion(track), length, beam, height, ship.ais, where)
+        return WorldObject(object_id, ship.name, "ship", mesh, ShipMotion(track), length, beam, height, ship.ais, where,
+                           mesh.centre_above_water_m())
 

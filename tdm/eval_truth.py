@@ -75,14 +75,30 @@ class _Kept:
 
 
 def _parse_sample(reader: LineReader, row: dict) -> tuple[tuple, str, str]:
-    """(sample (t, id, lat, lon, cog, sog, ais), name, kind) of one truth line, every field checked."""
-    sample = (reader.number_field(row, "t", lo=0.0, hi=MAX_TIME_S), reader.int_field(row, "id"),
-              reader.number_field(row, "lat", lo=-LAT_BOUND_DEG, hi=LAT_BOUND_DEG),
-              reader.number_field(row, "lon", lo=-LON_BOUND_DEG, hi=LON_BOUND_DEG),
-              reader.number_field(row, "cog_deg", default=math.nan, null=True),
-              reader.number_field(row, "sog_mps", default=math.nan, null=True),
-              reader.bool_field(row, "ais"))
-    return sample, reader.str_field(row, "name"), reader.str_field(row, "kind")
+    """(sample (t, id, lat, lon, cog, sog, ais), name, kind) of one truth line, every field checked.
+
+    ``lat``, ``lon`` of the sample are the object's centre (``centre_lat``, ``centre_lon``: the middle
+    of its above-water extents, which the TDM is asked to report) when the line has them, and its body
+    origin otherwise (files from before truth carried the centre). The own ship keeps its body origin:
+    the frame of the sensors' mounts and of the navigation. The body origin is checked either way.
+    """
+    t, object_id = reader.number_field(row, "t", lo=0.0, hi=MAX_TIME_S), reader.int_field(row, "id")
+    lat = reader.number_field(row, "lat", lo=-LAT_BOUND_DEG, hi=LAT_BOUND_DEG)
+    lon = reader.number_field(row, "lon", lo=-LON_BOUND_DEG, hi=LON_BOUND_DEG)
+    cog = reader.number_field(row, "cog_deg", default=math.nan, null=True)
+    sog = reader.number_field(row, "sog_mps", default=math.nan, null=True)
+    ais = reader.bool_field(row, "ais")
+    name, kind = reader.str_field(row, "name"), reader.str_field(row, "kind")
+    has_lat, has_lon = "centre_lat" in row, "centre_lon" in row
+    if has_lat != has_lon:
+        present, absent = ("centre_lat", "centre_lon") if has_lat else ("centre_lon", "centre_lat")
+        raise reader.fail(f"field {present!r} without {absent!r}")
+    if has_lat:
+        centre = (reader.number_field(row, "centre_lat", lo=-LAT_BOUND_DEG, hi=LAT_BOUND_DEG),
+                  reader.number_field(row, "centre_lon", lo=-LON_BOUND_DEG, hi=LON_BOUND_DEG))
+        if kind != OWNSHIP_KIND:
+            lat, lon = centre
+    return (t, object_id, lat, lon, cog, sog, ais), name, kind
 
 
 def _new_object(reader: LineReader, objects: dict, object_id: int, name: str, kind: str) -> _Object:

@@ -26,7 +26,7 @@ from typing import Callable
 
 import numpy as np
 
-from raysim.recording.jsonl import every, truth_epochs
+from raysim.recording.jsonl import every, row_centre_lat_lon, row_centre_xy, truth_epochs
 
 __all__ = ["FoxgloveView", "TOPICS"]
 
@@ -161,10 +161,10 @@ class FoxgloveView(threading.Thread):
         self.tf.log(FrameTransforms(transforms=transforms), log_time=self._ns(row["t"]))
 
     def _log_truth(self, t_s: float, rows: list[dict]) -> None:
-        entities = [self._box(t_s, f"{r['kind']}/{r['id']}", r["x"], r["y"], r["heading_deg"],
+        entities = [self._box(t_s, f"{r['kind']}/{r['id']}", *row_centre_xy(r), r["heading_deg"],
                               (r["length_m"], r["beam_m"], r["height_m"]), (0.2, 0.8, 0.2)) for r in rows]
         self._scene(self.truth, t_s, entities)
-        features = [{"type": "Feature", "geometry": {"type": "Point", "coordinates": [r["lon"], r["lat"]]},
+        features = [{"type": "Feature", "geometry": {"type": "Point", "coordinates": list(row_centre_lat_lon(r)[::-1])},
                      "properties": {"name": r["name"], "kind": r["kind"], "id": r["id"]}} for r in rows]
         self._geojson(self.truth_geo, t_s, features)
 

@@ -99,6 +99,23 @@ class BodyMesh:
         span = np.ptp(points, axis=0)
         return float(span[0]), float(span[1]), float(points[:, 2].max())
 
+    def centre_above_water_m(self) -> tuple[float, float]:
+        """Centre of the above-water part's extents in the body frame: the middle of the
+        length x beam box of :meth:`extents_above_water_m`.
+
+        Returns
+        -------
+        x_m, y_m : float
+            Along body x and body y, m; (0, 0) if nothing is above water. Not the body origin
+            in general: a mesh's origin may be at one end (a pier's landward end), and an
+            iceberg's is where its generator started, not the middle of what stands above water.
+        """
+        points = self.above_water_points_m()
+        if points.shape[0] == 0:
+            return 0.0, 0.0
+        middle = 0.5 * (points.min(axis=0) + points.max(axis=0))
+        return float(middle[0]), float(middle[1])
+
     def to_trimesh(self) -> trimesh.Trimesh:
         """A :class:`trimesh.Trimesh` with the same vertices and faces, in the same order.
 

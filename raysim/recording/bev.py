@@ -20,7 +20,7 @@ import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
 from groundfloor.frames import LocalFrame
-from raysim.recording.jsonl import truth_epochs
+from raysim.recording.jsonl import row_centre_xy, truth_epochs
 from raysim.recording.land_picture import LandOutline, clip_shoreline, read_land
 from raysim.recording.staging import atomic_path
 
@@ -91,15 +91,16 @@ def _sensor_pixels(own: dict, mount, scale: float):
 
 
 def _draw_boxes(draw: ImageDraw.ImageDraw, rows: list[dict], to_px) -> None:
-    """Every object's truth box (length x beam at its truth pose) but the own ship's."""
+    """Every object's truth box (length x beam about its centre, at its truth heading) but the own ship's."""
     for r in rows:
         if r["kind"] == "ownship":
             continue
         a = math.radians(90.0 - r["heading_deg"])
+        cx, cy = row_centre_xy(r)
         corners = []
         for u, v in ((1, 1), (1, -1), (-1, -1), (-1, 1)):
-            wx = r["x"] + u * r["length_m"] / 2 * math.cos(a) - v * r["beam_m"] / 2 * math.sin(a)
-            wy = r["y"] + u * r["length_m"] / 2 * math.sin(a) + v * r["beam_m"] / 2 * math.cos(a)
+            wx = cx + u * r["length_m"] / 2 * math.cos(a) - v * r["beam_m"] / 2 * math.sin(a)
+            wy = cy + u * r["length_m"] / 2 * math.sin(a) + v * r["beam_m"] / 2 * math.cos(a)
             corners.append(to_px(wx, wy))
         draw.polygon(corners, outline=BOX_COLOUR)
 

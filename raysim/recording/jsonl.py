@@ -13,8 +13,8 @@ import numpy as np
 
 from raysim.pose import heading_deg_from_yaw
 
-TRUTH_KEYS = ("t", "id", "name", "kind", "lat", "lon", "x", "y", "heading_deg", "cog_deg", "sog_mps",
-              "length_m", "beam_m", "height_m", "ais", "mmsi")
+TRUTH_KEYS = ("t", "id", "name", "kind", "lat", "lon", "x", "y", "centre_lat", "centre_lon", "centre_x", "centre_y",
+              "heading_deg", "cog_deg", "sog_mps", "length_m", "beam_m", "height_m", "ais", "mmsi")
 OWNSHIP_KEYS = ("t", "lat", "lon", "x", "y", "z", "heading_deg", "roll_deg", "pitch_deg", "cog_deg", "sog_mps")
 
 #: Below this speed the course over ground is undefined; truth reports the heading instead.
@@ -30,6 +30,40 @@ def course_and_speed(velocity_mps: np.ndarray, yaw_rad: np.ndarray) -> tuple[np.
     return cog, sog
 
 
+def centre_positions_m(position_m: np.ndarray, yaw_rad: np.ndarray, centre_body_m: tuple[float, float]) \
+        -> tuple[np.ndarray, np.ndarray]:
+    """Local east and north of a body-frame point (the object's centre) at each pose.
+
+    Parameters
+    ----------
+    position_m : (M, 3) float
+        Body origin, local frame (x east, y north), m.
+    yaw_rad : (M,) float
+        Body x axis from east, counter-clockwise, rad.
+    centre_body_m : (x, y) float
+        The point in the body frame (x forward, y to port), m.
+
+    Returns
+    -------
+    x_m, y_m : (M,) float
+    """
+    cx, cy = centre_body_m
+    cos, sin = np.cos(yaw_rad), np.sin(yaw_rad)
+    return position_m[:, 0] + cx * cos - cy * sin, position_m[:, 1] + cx * sin + cy * cos
+
+
+def row_centre_xy(row: dict) -> tuple[float, float]:
+    """A truth row's centre (``centre_x``, ``centre_y``), m; its body origin (``x``, ``y``) in a file from before
+    truth carried the centre."""
+    return row.get("centre_x", row["x"]), row.get("centre_y", row["y"])
+
+
+def row_centre_lat_lon(row: dict) -> tuple[float, float]:
+    """A truth row's centre (``centre_lat``, ``centre_lon``), deg; its body origin in a file from before
+    truth carried the centre."""
+    return row.get("centre_lat", row["lat"]), row.get("centre_lon", row["lon"])
+
+
 def _fmt_angle(a: np.ndarray) -> np.ndarray:
     """Round to 3 decimals and fold 360.000 back to 0.000."""
     a = np.round(a, 3)
@@ -41,20 +75,23 @@ def write_truth_chunk(handle: IO[str], t_s: np.ndarray, per_object: Sequence[dic
     """Append truth lines for the times ``t_s`` (M,), time-major, objects in id order.
 
     Each entry of ``per_object`` holds the static fields (id, name, kind, length_m,
-    beam_m, height_m, ais, mmsi) and (M,) arrays lat, lon, x, y, heading_deg,
-    cog_deg, sog_mps. Returns the number of lines written.
+    beam_m, height_m, ais, mmsi) and (M,) arrays lat, lon, x, y (the body origin), centre_lat,
+    centre_lon, centre_x, centre_y (the centre of the above-water extents), heading_deg, cog_deg,
+    sog_mps. Returns the number of lines written.
     """
     prefixes, columns = [], []
     for o in per_object:
         prefixes.append(f'"id": {o["id"]}, "name": {json.dumps(o["name"])}, "kind": "{o["kind"]}"')
         suffix = (f'"length_m": {o["length_m"]:.2f}, "beam_m": {o["beam_m"]:.2f}, "height_m": {o["height_m"]:.2f}, '
                   f'"ais": {"true" if o["ais"] else "false"}, "mmsi": {o["mmsi"] if o["mmsi"] is not None else "null"}}}')
-        columns.append((o["lat"], o["lon"], o["x"], o["y"], _fmt_angle(o["heading_deg"]), _fmt_angle(o["cog_deg"]), o["sog_mps"], suffix))
+        columns.append((o["lat"], o["lon"], o["x"], o["y"], o["centre_lat"], o["centre_lon"], o["centre_x"], o["centre_y"],
+                        _fmt_angle(o["heading_deg"]), _fmt_angle(o["cog_deg"]), o["sog_mps"], suffix))
     lines = []
     for k, t in enumerate(t_s):
-        for prefix, (lat, lon, x, y, hdg, cog, sog, suffix) in zip(prefixes, columns):
+        for prefix, (lat, lon, x, y, clat, clon, cx, cy, hdg, cog, sog, suffix) in zip(prefixes, columns):
             lines.append(
                 f'{{"t": {t:.4f}, {prefix}, "lat": {lat[k]:.9f}, "lon": {lon[k]:.9f}, "x": {x[k]:.3f}, "y": {y[k]:.3f}, '
+                f'"centre_lat": {clat[k]:.9f}, "centre_lon": {clon[k]:.9f}, "centre_x": {cx[k]:.3f}, "centre_y": {cy[k]:.3f}, '
                 f'"heading_deg": {hdg[k]:.3f}, "cog_deg": {cog[k]:.3f}, "sog_mps": {sog[k]:.3f}, {suffix}\n'
             )
     handle.write("".join(lines))

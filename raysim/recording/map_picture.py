@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
-from raysim.recording.jsonl import every, truth_epochs
+from raysim.recording.jsonl import every, row_centre_xy, truth_epochs
 from raysim.recording.land_picture import (LAND_COLOURS, LandOutline, clip_polygons, clip_shoreline, land_extent,
                                           read_land)
 from raysim.recording.staging import atomic_path
@@ -43,7 +43,7 @@ def _read_tracks(truth: Path, every_s: float = 1.0) -> dict:
         for row in rows:
             track = tracks.setdefault(row["id"], {"name": row["name"], "kind": row["kind"], "beam_m": row["beam_m"],
                                                   "xy": [], "t": []})
-            track["xy"].append((row["x"], row["y"]))
+            track["xy"].append(row_centre_xy(row))
             track["t"].append(row["t"])
     for track in tracks.values():
         track["xy"] = np.array(track["xy"])

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import copy
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -14,8 +15,9 @@ from raysim.cli import main
 from raysim.scenario import load_scenario
 from tests.conftest import BASE
 
-CONTRACT_TRUTH_KEYS = ["t", "id", "name", "kind", "lat", "lon", "x", "y", "heading_deg", "cog_deg", "sog_mps",
-                       "length_m", "beam_m", "height_m", "ais", "mmsi"]
+CONTRACT_TRUTH_KEYS = ["t", "id", "name", "kind", "lat", "lon", "x", "y", "centre_lat", "centre_lon", "centre_x", "centre_y",
+                       "heading_deg", "cog_deg", "sog_mps", "length_m", "beam_m", "height_m", "ais", "mmsi"]
+REPO = Path(__file__).resolve().parents[2]
 CONTRACT_OWNSHIP_KEYS = ["t", "lat", "lon", "x", "y", "z", "heading_deg", "roll_deg", "pitch_deg", "cog_deg", "sog_mps"]
 
 
@@ -62,6 +64,26 @@ def test_truth_has_every_object_every_tenth_of_a_second(recording):
     berg = [r for r in rows if r["id"] == 1][0]
     assert berg["height_m"] == pytest.approx(8.0, abs=0.01)
     assert berg["lat"] == pytest.approx(59.436573, abs=1e-9) and berg["lon"] == pytest.approx(10.470952, abs=1e-9)
+
+
+@pytest.mark.parametrize("heading_deg, east_m, north_m", [(180.0, 0.0, -30.0), (90.0, 30.0, 0.0), (45.0, 21.2132, 21.2132)])
+def test_truth_centre_is_the_middle_of_what_stands_above_water(write_scenario, tmp_path, heading_deg, east_m, north_m):
+    """meshes/pier.glb has its origin at its landward end (above water: x 0..60 m, y -4.3..4.3 m), so its centre
+    lies 30 m from the origin along its heading; the truth box (length x beam) stands about that centre."""
+    data = copy.deepcopy(BASE)
+    data["duration_s"] = 1
+    data["obstacles"] = [{"name": "pier", "kind": "mesh", "position": [59.4390, 10.4700], "heading_deg": heading_deg,
+                          "mesh": str(REPO / "meshes" / "pier.glb"), "material": "concrete"}]
+    data["ships"] = [{"name": "anchored", "length_m": 20, "waypoints": [[59.4380, 10.4700]], "heading_deg": 45}]
+    rows = _lines(_render(write_scenario(data), tmp_path / "rec") / "truth.jsonl")
+    pier = [r for r in rows if r["name"] == "pier"][0]
+    assert (pier["length_m"], pier["beam_m"]) == (60.0, 8.6)
+    assert pier["centre_x"] - pier["x"] == pytest.approx(east_m, abs=2e-3)
+    assert pier["centre_y"] - pier["y"] == pytest.approx(north_m, abs=2e-3)
+    azimuth, _, distance = Geod(ellps="WGS84").inv(pier["lon"], pier["lat"], pier["centre_lon"], pier["centre_lat"])
+    assert distance == pytest.approx(30.0, abs=0.01) and azimuth % 360.0 == pytest.approx(heading_deg, abs=0.05)
+    ship = [r for r in rows if r["name"] == "anchored"][0]  # a generated hull is centred on its origin
+    assert np.hypot(ship["centre_x"] - ship["x"], ship["centre_y"] - ship["y"]) < 0.5
 
 
 def test_ship_in_truth_moves_along_the_geodesic_at_its_speed(write_scenario, tmp_path):

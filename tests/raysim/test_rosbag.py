@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 
 import numpy as np
 import pytest
@@ -207,7 +208,13 @@ def test_bag_radar_picture_and_truth_labels_and_geojson(recording):
     for feature in geo["features"]:
         lon, lat = feature["geometry"]["coordinates"]
         row = at_one[feature["properties"]["name"]]
-        assert (lon, lat) == pytest.approx((row["lon"], row["lat"]), abs=1e-8)
+        assert (lon, lat) == pytest.approx((row["centre_lon"], row["centre_lat"]), abs=1e-8)  # the centre
+    by_id = {r["id"]: r for r in at_one.values()}
+    for box in (m for m in markers if m.type == 1):  # each truth box stands about its object's centre
+        row = by_id[box.id]
+        assert (box.pose.position.x, box.pose.position.y) == pytest.approx((row["centre_x"], row["centre_y"]), abs=1e-3)
+    berg = at_one["Iceberg_1"]  # a generated berg's centre is not its body origin
+    assert math.hypot(berg["centre_x"] - berg["x"], berg["centre_y"] - berg["y"]) > 0.5
 
 
 def test_the_foxglove_layout_names_topics_the_bag_has(recording):

@@ -207,7 +207,7 @@ def test_plots_are_deterministic_pngs(synthetic):
 
 
 def test_perfect_targets_on_a_rendered_recording(bos_recording, tmp_path):
-    """Targets placed on the truth of a real recording score zero error and full detection."""
+    """Targets placed on the truth of a real recording (each object's centre) score zero error and full detection."""
     rec = tmp_path / "rec"
     (rec / "lidar").mkdir(parents=True)
     for name in ("truth.jsonl", "scenario.yaml", "manifest.json"):
@@ -220,7 +220,7 @@ def test_perfect_targets_on_a_rendered_recording(bos_recording, tmp_path):
             if r["kind"] != "ownship" and abs(r["t"] - round(r["t"])) < 1e-6:
                 f.write(json.dumps({"t": float(round(r["t"])), "target_id": 100 + r["id"],
                                     "object_descriptor": {"ship": "vessel"}.get(r["kind"], r["kind"]),
-                                    "longitude": r["lon"], "latitude": r["lat"], "cog_deg": r["cog_deg"],
+                                    "longitude": r["centre_lon"], "latitude": r["centre_lat"], "cog_deg": r["cog_deg"],
                                     "sog_mps": r["sog_mps"], "cross_section_m2": 1.0, "sources": ["radar"],
                                     "position_cov_m2": [[1.0, 0.0], [0.0, 1.0]]}) + "\n")
     m = evaluate(rec)
@@ -284,3 +284,35 @@ def test_an_unreadable_radar_sweep_counts_as_not_seen_as_in_tdm_run(tmp_path):
     (sweeps / "000001.npz").write_bytes(b"not an npz file")
     metrics = evaluate(rec)
     assert metrics["warnings"] == {"radar/sweeps: unreadable sweep files (not a zip archive), counted as not seen": 1}
+
+
+def _with_centres(recording, east_m, own_east_m):
+    """Give every truth line ``centre_lat``/``centre_lon``: the body origin moved ``east_m`` east (the own ship's
+    ``own_east_m``)."""
+    path = recording / "truth.jsonl"
+    rows = [json.loads(line) for line in path.read_text(encoding="utf-8").splitlines()]
+    from tdm.frames import EnuFrame
+    from .eval_helpers import LAT0, LON0
+    frame = EnuFrame(LAT0, LON0)
+    for row in rows:
+        shift = own_east_m if row["kind"] == "ownship" else east_m
+        lat, lon = frame.to_geodetic(row["x"] + shift, row["y"])
+        row["centre_lat"], row["centre_lon"] = float(lat), float(lon)
+    path.write_text("".join(json.dumps(r) + "\n" for r in rows), encoding="utf-8")
+
+
+def test_objects_are_scored_at_their_centre_when_truth_has_it(tmp_path):
+    """The targets lie 3 m east of each body origin: 3 m off by the origin, on the centre when truth puts it there.
+    The own ship stays at its body origin (the frame of the mounts), whatever its centre."""
+    from tdm.eval_truth import read_truth_enu
+
+    rec = make_recording(tmp_path / "rec")
+    _with_centres(rec, 3.0, 50.0)
+    m = evaluate(rec)
+    assert m["position_rmse_m"] == pytest.approx(0.0, abs=1e-4)
+    assert m["position_bias_east_m"] == pytest.approx(0.0, abs=1e-4)
+    _, truth = read_truth_enu(rec)
+    own = truth["kind"] == "ownship"
+    assert np.allclose(truth["east_m"][own], 0.0, atol=1e-6)
+    bravo = truth["name"] == "bravo"
+    assert np.allclose(truth["east_m"][bravo], 3.0, atol=1e-6)

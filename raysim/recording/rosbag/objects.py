@@ -23,7 +23,7 @@ from typing import Callable, Iterator
 import numpy as np
 
 from groundfloor.units import KNOTS_PER_MPS
-from raysim.recording.jsonl import every, truth_epochs
+from raysim.recording.jsonl import every, row_centre_lat_lon, row_centre_xy, truth_epochs
 from raysim.recording.rosbag.msgs import BagMessage, duration, header, make, point, pose, yaw_quaternion
 
 __all__ = ["truth_streams", "target_streams", "KIND_COLOURS", "target_box_m"]
@@ -81,13 +81,13 @@ def truth_streams(recording: Path, ns_of: NsOf) -> Iterator[BagMessage]:
         markers = [_delete_all(t_ns)]
         for r in rows:
             size = (max(r["length_m"], 0.1), max(r["beam_m"], 0.1), max(r["height_m"], 0.1))
-            markers += _box_and_label(t_ns, r["kind"], r["id"], (r["x"], r["y"], size[2] / 2.0),
+            markers += _box_and_label(t_ns, r["kind"], r["id"], (*row_centre_xy(r), size[2] / 2.0),
                                       math.radians(90.0 - r["heading_deg"]), size,
                                       KIND_COLOURS.get(r["kind"], (0.6, 0.6, 0.6)), r["name"], 1.5)
         yield BagMessage(t_ns, "/truth/objects", "visualization_msgs/msg/MarkerArray",
                          make("visualization_msgs/msg/MarkerArray", markers=markers))
         yield _geojson(t_ns, "/truth/geojson", [
-            _point_feature(r["lon"], r["lat"], {"name": r["name"], "kind": r["kind"], "id": r["id"],
+            _point_feature(row_centre_lat_lon(r)[1], row_centre_lat_lon(r)[0], {"name": r["name"], "kind": r["kind"], "id": r["id"],
                                                 "sog_mps": r["sog_mps"], "heading_deg": r["heading_deg"]})
             for r in rows])
 
