@@ -18,7 +18,9 @@ from raysim.recording import jsonl, nmea, npz, pointclouds
 def truth_object(**over):
     o = {"id": 3, "name": 'ship "A"', "kind": "ship", "length_m": 40.0, "beam_m": 8.125, "height_m": 12.0,
          "ais": True, "mmsi": 257000009, "lat": np.array([59.1234567891, 59.2]), "lon": np.array([10.5, 10.6]),
-         "x": np.array([1.0004, -2.5]), "y": np.array([3.0, 4.0]), "heading_deg": np.array([359.9996, 90.0]),
+         "x": np.array([1.0004, -2.5]), "y": np.array([3.0, 4.0]), "centre_lat": np.array([59.1234571, 59.2]),
+         "centre_lon": np.array([10.5, 10.6000001]), "centre_x": np.array([1.0004, -2.5]),
+         "centre_y": np.array([3.0456, 4.0]), "heading_deg": np.array([359.9996, 90.0]),
          "cog_deg": np.array([10.0, 20.0]), "sog_mps": np.array([5.1234, 0.0])}
     o.update(over)
     return o
@@ -29,7 +31,8 @@ def test_truth_lines_have_fixed_decimals_and_key_order():
     assert jsonl.write_truth_chunk(handle, np.array([0.0, 0.1]), [truth_object()]) == 2
     first = handle.getvalue().splitlines()[0]
     assert first == ('{"t": 0.0000, "id": 3, "name": "ship \\"A\\"", "kind": "ship", "lat": 59.123456789, '
-                     '"lon": 10.500000000, "x": 1.000, "y": 3.000, "heading_deg": 0.000, "cog_deg": 10.000, '
+                     '"lon": 10.500000000, "x": 1.000, "y": 3.000, "centre_lat": 59.123457100, '
+                     '"centre_lon": 10.500000000, "centre_x": 1.000, "centre_y": 3.046, "heading_deg": 0.000, "cog_deg": 10.000, '
                      '"sog_mps": 5.123, "length_m": 40.00, "beam_m": 8.12, "height_m": 12.00, "ais": true, '
                      '"mmsi": 257000009}')
     rows = [json.loads(line) for line in handle.getvalue().splitlines()]
@@ -43,6 +46,15 @@ def test_truth_lines_are_time_major_and_null_mmsi():
     rows = [json.loads(line) for line in handle.getvalue().splitlines()]
     assert [(r["t"], r["id"]) for r in rows] == [(0.0, 1), (0.0, 2), (0.1, 1), (0.1, 2)]
     assert rows[1]["mmsi"] is None and rows[1]["ais"] is False
+
+
+@pytest.mark.parametrize("yaw_deg, east_m, north_m", [(0.0, 30.0, 2.0), (90.0, -2.0, 30.0), (-90.0, 2.0, -30.0),
+                                                      (180.0, -30.0, -2.0)])
+def test_a_body_point_lands_where_the_yaw_turns_it(yaw_deg, east_m, north_m):
+    """Body (30 m forward, 2 m to port) at yaw 0 (facing east), 90 (north), -90 (south), 180 (west)."""
+    position = np.array([[100.0, 200.0, 0.5]])
+    x, y = jsonl.centre_positions_m(position, np.radians([yaw_deg]), (30.0, 2.0))
+    assert (x[0] - 100.0, y[0] - 200.0) == pytest.approx((east_m, north_m), abs=1e-9)
 
 
 def test_ownship_lines():
@@ -67,7 +79,8 @@ def test_truth_epochs_reads_back_the_kept_times(tmp_path):
     path = tmp_path / "truth.jsonl"
     with open(path, "w", encoding="utf-8") as handle:
         jsonl.write_truth_chunk(handle, np.array([0.0, 0.5, 1.0]), [truth_object(id=1, **{
-            k: np.zeros(3) for k in ("lat", "lon", "x", "y", "heading_deg", "cog_deg", "sog_mps")})])
+            k: np.zeros(3) for k in ("lat", "lon", "x", "y", "centre_lat", "centre_lon", "centre_x", "centre_y",
+                                     "heading_deg", "cog_deg", "sog_mps")})])
     epochs = list(jsonl.truth_epochs(path, jsonl.every(1.0)))
     assert [t for t, _ in epochs] == [0.0, 1.0]
     assert all(len(rows) == 1 and rows[0]["id"] == 1 for _, rows in epochs)
