@@ -44,6 +44,7 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
 from benchmarks.common import machine_line  # noqa: E402
+from raysim.recording.jsonl import row_centre_xy  # noqa: E402
 from raysim.render import render  # noqa: E402
 from raysim.scenario import load_scenario, with_overrides  # noqa: E402
 from tdm.eval_best_sensor import FIGURES  # noqa: E402
@@ -77,7 +78,7 @@ def closest_approach_m(recording: Path) -> dict[str, float]:
             if row["kind"] == "ownship":
                 own[row["t"]] = (row["x"], row["y"])
             else:
-                rows.append((row["name"], row["t"], row.get("centre_x", row["x"]), row.get("centre_y", row["y"])))
+                rows.append((row["name"], row["t"], *row_centre_xy(row)))
     closest: dict[str, float] = {}
     for name, t, x, y in rows:
         ox, oy = own[t]

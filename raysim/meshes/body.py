@@ -7,6 +7,7 @@ the object's reference point, the point placed at the object's scenario ``positi
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import trimesh
@@ -93,11 +94,11 @@ class BodyMesh:
             Extent along body x, extent along body y (m), and the highest z (m above the
             waterline). All zero if nothing is above water.
         """
-        points = self.above_water_points_m()
-        if points.shape[0] == 0:
+        bounds = self._above_water_bounds_m
+        if bounds is None:
             return 0.0, 0.0, 0.0
-        span = np.ptp(points, axis=0)
-        return float(span[0]), float(span[1]), float(points[:, 2].max())
+        low, high = bounds
+        return float(high[0] - low[0]), float(high[1] - low[1]), float(high[2])
 
     def centre_above_water_m(self) -> tuple[float, float]:
         """Centre of the above-water part's extents in the body frame: the middle of the
@@ -110,11 +111,20 @@ class BodyMesh:
             in general: a mesh's origin may be at one end (a pier's landward end), and an
             iceberg's is where its generator started, not the middle of what stands above water.
         """
+        bounds = self._above_water_bounds_m
+        if bounds is None:
+            return 0.0, 0.0
+        middle = 0.5 * (bounds[0] + bounds[1])
+        return float(middle[0]), float(middle[1])
+
+    @cached_property
+    def _above_water_bounds_m(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """(3,) least and (3,) greatest coordinates of :meth:`above_water_points_m`, m; None if nothing is
+        above water. Worked out once per mesh (the waterline section walks every triangle)."""
         points = self.above_water_points_m()
         if points.shape[0] == 0:
-            return 0.0, 0.0
-        middle = 0.5 * (points.min(axis=0) + points.max(axis=0))
-        return float(middle[0]), float(middle[1])
+            return None
+        return points.min(axis=0), points.max(axis=0)
 
     def to_trimesh(self) -> trimesh.Trimesh:
         """A :class:`trimesh.Trimesh` with the same vertices and faces, in the same order.

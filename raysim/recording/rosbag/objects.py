@@ -87,7 +87,7 @@ def truth_streams(recording: Path, ns_of: NsOf) -> Iterator[BagMessage]:
         yield BagMessage(t_ns, "/truth/objects", "visualization_msgs/msg/MarkerArray",
                          make("visualization_msgs/msg/MarkerArray", markers=markers))
         yield _geojson(t_ns, "/truth/geojson", [
-            _point_feature(row_centre_lat_lon(r)[1], row_centre_lat_lon(r)[0], {"name": r["name"], "kind": r["kind"], "id": r["id"],
+            _point_feature(*row_centre_lat_lon(r)[::-1], {"name": r["name"], "kind": r["kind"], "id": r["id"],
                                                 "sog_mps": r["sog_mps"], "heading_deg": r["heading_deg"]})
             for r in rows])
 
