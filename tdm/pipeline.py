@@ -92,6 +92,7 @@ class _Tracking:
         self.ais.set_static(stream.static)
         self.fuser = Fuser(FusionConfig(**{**config.fusion_config.__dict__, "rule": config.fusion}))
         self.fuser.lengths_by_mmsi = {m: s.length_m for m, s in stream.static.items() if np.isfinite(s.length_m)}
+        self.fuser.beams_by_mmsi = {m: s.beam_m for m, s in stream.static.items() if np.isfinite(s.beam_m)}
         self.scans = {"lidar": 0, "radar": 0, "ais": len(stream.reports)}
         self.n_lines = 0
         self.target_ids: set[int] = set()
