@@ -43,7 +43,7 @@ import numpy as np
 
 from tdm import ekf
 from tdm.association import chi2_gate, gnn, mahalanobis2
-from tdm.fusion_rules import fuse
+from tdm.fusion_rules import consider_covariance, fuse
 from tdm.hull import hull_covariance
 from tdm.tracker import Track, predicted_at
 
@@ -120,6 +120,10 @@ class FusionConfig:
     # whole near side. No parameter fitted; on busy_open_sea seed 7 (the tuning run) fused NEES in its interval
     # 0.867 -> 0.879, median error beyond LiDAR range 3.76 -> 3.72 m, within it 2.63 -> 2.71 m (docs/tdm.md)
     weigh_hull: bool = True
+    # report each target's covariance with the LiDAR's near-side offset in it: a LiDAR track's centre uncertainty
+    # behind the side seen (Track.extent_var_m2) taken through the fusion's weights as a consider term
+    # (fusion_rules.consider_covariance); the fused state and what the fusion weighs are unchanged
+    consider_lidar_extent: bool = True
 
 
 @dataclass
@@ -318,12 +322,13 @@ class Fuser:
             weigh = self._with_hull(weigh, live)
         for target in self.targets:
             x, p = self._estimate(target, weigh)
+            reported_p = self._considered(target, weigh, live, p) if cfg.consider_lidar_extent else p
             target.last_x, target.last_t_s, target.radius_m = x, t_s, self._half_length(target, live)
             ais_track = live.get(("ais", target.members.get("ais", -1)))
             target.mmsi = ais_track.mmsi if ais_track is not None else target.mmsi
             heights = [live[(s, i)].height_m for s, i in target.members.items() if s == "lidar"]
             self._classify(target, x, p, t_s, heights[0] if heights else float("nan"))
-            out.append(FusedEstimate(target, x, p, sorted(target.members)))
+            out.append(FusedEstimate(target, x, reported_p, sorted(target.members)))
         return out
 
     @staticmethod
@@ -338,6 +343,17 @@ class Fuser:
                 p[:2, :2] += tr.extent_var_m2 * np.eye(2)
                 out[key] = (x, p)
         return out
+
+    def _considered(self, target: FusedTarget, states: dict, live: dict, p: np.ndarray) -> np.ndarray:
+        """``p`` (6, 6), the target's fused covariance, with its LiDAR track's extent variance taken through the
+        fusion (``consider_lidar_extent``, :func:`tdm.fusion_rules.consider_covariance`)."""
+        keys = list(target.members.items())
+        var = np.array([live[k].extent_var_m2 if k[0] == "lidar" else 0.0 for k in keys])
+        if not np.any(var > 0.0):
+            return p
+        xs = np.array([states[k][0] for k in keys])
+        ps = np.array([states[k][1] for k in keys])
+        return p + consider_covariance(xs, ps, var, self.config.rule)
 
     def _with_hull(self, states: dict, live: dict) -> dict:
         """``states`` with the hull's variance (``weigh_hull``, :func:`hull_covariance`) added to the position

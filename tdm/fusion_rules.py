@@ -7,7 +7,7 @@ import numpy as np
 
 from tdm import ekf
 
-__all__ = ["canonical_states", "fuse"]
+__all__ = ["canonical_states", "consider_covariance", "fuse"]
 
 
 def fuse(xs: np.ndarray, ps: np.ndarray, rule: str = "simple") -> tuple[np.ndarray, np.ndarray]:
@@ -40,6 +40,46 @@ def fuse(xs: np.ndarray, ps: np.ndarray, rule: str = "simple") -> tuple[np.ndarr
     x = p @ np.einsum("kij,kj->i", infos, xs)
     x[ekf.PSI] = ekf.wrap_pi(x[ekf.PSI])
     return x, 0.5 * (p + p.T)
+
+
+def consider_covariance(xs: np.ndarray, ps: np.ndarray, position_var_m2: np.ndarray, rule: str = "simple"
+                        ) -> np.ndarray:
+    """Covariance of the error a fusion (:func:`fuse`) takes over from biases of its estimates' positions.
+
+    Each estimate's position may carry a bias its covariance does not hold (a sensor sees the near side of an
+    object: where its centre lies is a slowly changing offset, not noise; a "consider" parameter, as in the
+    Schmidt-Kalman filter). The fused state is ``x = sum_k W_k x_k`` with ``W_k = P I_k`` (``I_k`` the k-th
+    estimate's information, times its weight for ``ci``), so independent biases ``b_k`` of variance ``v_k`` per
+    axis (east, north) add ``sum_k v_k W_k[:, :2] W_k[:, :2]^T`` to its covariance; the state itself is
+    not changed.
+
+    Parameters
+    ----------
+    xs : (K, 6) float
+    ps : (K, 6, 6) float
+        The estimates fused, as given to :func:`fuse`.
+    position_var_m2 : (K,) float
+        Variance of each estimate's position bias per axis, m^2.
+    rule : {"simple", "ci"}
+
+    Returns
+    -------
+    (6, 6) float
+    """
+    v = np.asarray(position_var_m2, dtype=float)
+    if len(xs) == 1:
+        out = np.zeros((ekf.N_STATES, ekf.N_STATES))
+        out[:2, :2] = v[0] * np.eye(2)
+        return out
+    _, ps = canonical_states(xs, ps)
+    infos = np.linalg.inv(ps)
+    if rule == "ci":
+        w = 1.0 / np.trace(ps, axis1=1, axis2=2)
+        infos = infos * (w / w.sum())[:, None, None]
+    p = np.linalg.inv(infos.sum(axis=0))
+    cols = np.einsum("ij,kjl->kil", p, infos[:, :, :2])  # (K, 6, 2): W_k[:, :2]
+    out = np.einsum("k,kia,kja->ij", v, cols, cols)
+    return 0.5 * (out + out.T)
 
 
 def canonical_states(xs: np.ndarray, ps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -295,3 +295,37 @@ def test_targets_found_clearly_apart_all_at_once_are_apart_one_by_one():
                 n_apart += bool(apart[i, j])
                 n_outside += outside
     assert n_apart > 0.9 * n_outside
+
+
+def test_a_bias_of_one_estimate_reaches_the_fused_covariance_through_its_weight():
+    """Two estimates with equal covariances fuse with weights 1/2 each: independent position biases of variance
+    v1 and v2 per axis add (v1 + v2) / 4 to the fused position's variance; a lone estimate keeps its v whole."""
+    from tdm.fusion_rules import consider_covariance
+
+    p = np.diag([4.0, 4.0, 0.01, 0.25, 1e-4, 100.0])
+    xs = np.array([[0.0, 0.0, 0.1, 5.0, 0.0, 10.0], [1.0, 2.0, 0.1, 5.0, 0.0, 10.0]])
+    out = consider_covariance(xs, np.array([p, p]), np.array([9.0, 1.0]))
+    np.testing.assert_allclose(out[:2, :2], (9.0 + 1.0) / 4.0 * np.eye(2), atol=1e-12)
+    np.testing.assert_allclose(out[2:, 2:], 0.0, atol=1e-12)
+    lone = consider_covariance(xs[:1], np.array([p]), np.array([9.0]))
+    np.testing.assert_allclose(lone[:2, :2], 9.0 * np.eye(2))
+    assert np.count_nonzero(lone) == 2
+    # a bias of the less certain estimate reaches the fused state by its smaller weight: 1 / (1 + 4) of 4 m^2 vs 1 m^2
+    q = p.copy()
+    q[:2, :2] = 16.0 * np.eye(2)
+    weighted = consider_covariance(xs, np.array([p, q]), np.array([0.0, 25.0]))
+    np.testing.assert_allclose(weighted[:2, :2], 25.0 * (4.0 / 20.0) ** 2 * np.eye(2), atol=1e-12)
+
+
+@pytest.mark.parametrize("consider", [False, True])
+def test_the_lidars_near_side_offset_is_reported_in_the_covariance_not_the_state(consider):
+    """A LiDAR track (var 1 m^2, 10 m long, extent 0.3 of it: 9 m^2 of offset) and a radar track 4 m east (var
+    4 m^2): the fused position is the same either way; the reported variance gains 9 x (0.8)^2 = 5.76 m^2 (the
+    LiDAR's weight 4 / 5) with ``consider_lidar_extent``."""
+    fuser = Fuser(FusionConfig(consider_lidar_extent=consider))
+    lidar = make_track(1, "lidar", 0.0, 100.0, var=1.0)
+    lidar.length_m, lidar.extent_sigma_fraction = 10.0, 0.3
+    radar = make_track(2, "radar", 4.0, 100.0, var=4.0)
+    (out,) = fuser.step(0.0, {"lidar": [lidar], "radar": [radar]})
+    assert out.x[0] == pytest.approx(4.0 * 0.25 / 1.25)
+    assert out.p[0, 0] == pytest.approx(1.0 / 1.25 + (9.0 * 0.8 ** 2 if consider else 0.0))
