@@ -249,7 +249,7 @@ def _cluster_detections(enu: np.ndarray, t: np.ndarray, label: np.ndarray, n_cel
                                      mount)
     if config.centre == "outline":
         depth_fraction = np.where(fp.length_m < config.hidden_depth_max_elongation * fp.width_m,
-                                  config.hidden_depth_fraction, 0.0)
+                                  config.hidden_depth_fraction, config.hidden_depth_fraction_elongated)
         centre_e, centre_n = _outline_centres(enu, label, n_cells, fp, sensor_enu, depth_fraction)
     else:
         centre_e, centre_n = fp.mean_e, fp.mean_n

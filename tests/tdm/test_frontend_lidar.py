@@ -85,7 +85,7 @@ def detect(boxes, **config) -> Detections:
 
 
 def test_a_wall_broadside_is_one_box_at_its_place():
-    det = detect([(30.0, 0.0, 10.0, 0.3, 90.0, 6.0)])   # 10 m long, running east-west, 30 m north
+    det = detect([(30.0, 0.0, 10.0, 0.3, 90.0, 6.0)], hidden_depth_fraction_elongated=0.0)  # 10 m long, east-west
     assert len(det) == 1
     assert det.position_m[0] == pytest.approx([0.0, 29.85], abs=0.1)   # the near face, 0.15 m short of the centre
     assert det.length_m[0] == pytest.approx(10.0, abs=0.2)
@@ -102,7 +102,8 @@ def test_a_wall_broadside_is_one_box_at_its_place():
 def test_the_outline_centre_of_a_box_at_an_angle_is_its_centre_and_the_mean_is_short():
     box = [(30.0, -5.0, 12.0, 4.0, 50.0, 6.0)]   # centre 30 m north, 5 m east, seen at an angle
     truth = np.array([5.0, 30.0])
-    outline, mean = detect(box), detect(box, centre="mean")
+    # the outline itself: without the hidden depth a long footprint is given (it shows two faces here)
+    outline, mean = detect(box, hidden_depth_fraction_elongated=0.0), detect(box, centre="mean")
     assert len(outline) == len(mean) == 1
     assert np.linalg.norm(outline.position_m[0] - truth) < 0.4
     # the mean of the visible faces lies toward the sensor
@@ -110,10 +111,11 @@ def test_the_outline_centre_of_a_box_at_an_angle_is_its_centre_and_the_mean_is_s
     assert np.linalg.norm(mean.position_m[0] - truth) > 1.0
 
 
-def test_a_compact_cluster_is_put_its_hidden_depth_behind_its_outline_and_a_long_wall_is_not():
+def test_a_compact_cluster_is_put_its_hidden_depth_behind_its_outline_and_a_long_wall_its_elongated_one():
     """An 8 m square block turned 45 deg, 30 m north, shows two faces in a V, 11.3 m across and 5.7 m deep: its
     outline midpoint (the side corners') lies at 30 m; the hidden-depth fraction f puts it f x 5.66 m (half the
-    width across the line of sight) further along it. A wall (length over width far over 3) is not moved."""
+    width across the line of sight) further along it. A 10 m wall broadside (length over width far over 3), a hull
+    side, is put ``hidden_depth_fraction_elongated`` x 5 m behind it instead."""
     block = [(30.0, 0.0, 8.0, 8.0, 45.0, 5.0)]
     outline, behind = detect(block, hidden_depth_fraction=0.0), detect(block)
     assert outline.position_m[0] == pytest.approx([0.0, 30.0], abs=0.2)
@@ -121,6 +123,11 @@ def test_a_compact_cluster_is_put_its_hidden_depth_behind_its_outline_and_a_long
     assert fraction > 0.0
     assert behind.position_m[0] == pytest.approx([0.0, 30.0 + fraction * 4.0 * math.sqrt(2.0)], abs=0.2)
     wall = [(30.0, 0.0, 10.0, 0.3, 90.0, 6.0)]
+    elongated = LidarFrontEndConfig().hidden_depth_fraction_elongated
+    assert 0.0 < elongated < fraction
+    seen = detect(wall, hidden_depth_fraction=0.0, hidden_depth_fraction_elongated=0.0).position_m[0]
+    assert detect(wall, hidden_depth_fraction=0.0).position_m[0] == pytest.approx(seen + [0.0, elongated * 5.0],
+                                                                                 abs=0.05)
     assert detect(wall).position_m[0] == pytest.approx(detect(wall, hidden_depth_fraction=0.0).position_m[0])
 
 
