@@ -29,6 +29,15 @@ def fuse(xs: np.ndarray, ps: np.ndarray, rule: str = "simple") -> tuple[np.ndarr
     xs, ps = canonical_states(xs, ps)
     ref = xs[0, ekf.PSI]
     xs[:, ekf.PSI] = ref + ekf.wrap_pi(xs[:, ekf.PSI] - ref)  # angles relative to one branch
+    infos, p = _weighted_informations(ps, rule)
+    x = p @ np.einsum("kij,kj->i", infos, xs)
+    x[ekf.PSI] = ekf.wrap_pi(x[ekf.PSI])
+    return x, 0.5 * (p + p.T)
+
+
+def _weighted_informations(ps: np.ndarray, rule: str) -> tuple[np.ndarray, np.ndarray]:
+    """(K, 6, 6) information of each estimate as ``rule`` weighs it (``ci``: times ``w_k ~ 1 / tr P_k``), and
+    (6, 6) the fused covariance, their sum's inverse."""
     infos = np.linalg.inv(ps)
     if rule == "ci":
         w = 1.0 / np.trace(ps, axis1=1, axis2=2)
@@ -36,10 +45,7 @@ def fuse(xs: np.ndarray, ps: np.ndarray, rule: str = "simple") -> tuple[np.ndarr
         infos = infos * w[:, None, None]
     elif rule != "simple":
         raise ValueError(f"unknown fusion rule {rule!r}")
-    p = np.linalg.inv(infos.sum(axis=0))
-    x = p @ np.einsum("kij,kj->i", infos, xs)
-    x[ekf.PSI] = ekf.wrap_pi(x[ekf.PSI])
-    return x, 0.5 * (p + p.T)
+    return infos, np.linalg.inv(infos.sum(axis=0))
 
 
 def consider_covariance(xs: np.ndarray, ps: np.ndarray, position_var_m2: np.ndarray, rule: str = "simple"
@@ -72,11 +78,7 @@ def consider_covariance(xs: np.ndarray, ps: np.ndarray, position_var_m2: np.ndar
         out[:2, :2] = v[0] * np.eye(2)
         return out
     _, ps = canonical_states(xs, ps)
-    infos = np.linalg.inv(ps)
-    if rule == "ci":
-        w = 1.0 / np.trace(ps, axis1=1, axis2=2)
-        infos = infos * (w / w.sum())[:, None, None]
-    p = np.linalg.inv(infos.sum(axis=0))
+    infos, p = _weighted_informations(ps, rule)
     cols = np.einsum("ij,kjl->kil", p, infos[:, :, :2])  # (K, 6, 2): W_k[:, :2]
     out = np.einsum("k,kia,kja->ij", v, cols, cols)
     return 0.5 * (out + out.T)
