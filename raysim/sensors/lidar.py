@@ -22,6 +22,7 @@ import numpy as np
 
 from groundfloor import hdl32e
 from groundfloor.frames import mount_transform  # noqa: F401 (raysim.sensors.lidar.mount_transform)
+from raysim import jit
 from raysim.materials import material_index, material_table
 from raysim.random_streams import stream
 from raysim.recording import nmea
@@ -29,6 +30,7 @@ from raysim.recording.staging import atomic_path
 from raysim.recording.velodyne import PcapWriter, encode_data_packets, encode_position_packet
 from raysim.scene import NO_HIT, SEA_ID, intersect_sea
 from raysim.sea import FoamField
+from raysim.sensors import lidar_kernels
 from raysim.sensors import lidar_physics as phys
 from raysim.sensors.blas_threads import single_blas_thread
 from raysim.sensors.carrier import CarrierScene
@@ -58,6 +60,8 @@ CYCLE_COUNT_SLACK = 1e-9
 SECONDS_PER_HOUR = 3600.0
 MICROSECONDS_PER_SECOND = 1e6
 DEG_PER_TURN = 360.0
+#: Each laser's firing instant as a fraction of the 46.08 us cycle, (32,).
+FIRING_FRACTION = np.arange(hdl32e.N_LASERS) * (hdl32e.FIRING_DT_S / hdl32e.CYCLE_DT_S)
 
 
 @dataclass
@@ -127,6 +131,11 @@ class LidarChunk:
     payloads: np.ndarray
     sent_s: np.ndarray
     position_times_s: list
+
+
+def _firing_times(cycle_time_s: np.ndarray) -> np.ndarray:
+    """(C, 32) time of each firing of C cycles, s."""
+    return cycle_time_s[:, None] + np.arange(hdl32e.N_LASERS)[None, :] * hdl32e.FIRING_DT_S
 
 
 def _add_scaled(total: np.ndarray, change: np.ndarray, scale: np.ndarray) -> None:
@@ -250,22 +259,11 @@ class LidarRenderer:
         t_firing : (C, 32) float64
             Time of each firing, s.
         """
-        t_edges = np.append(cycle_time_s, cycle_time_s[-1] + hdl32e.CYCLE_DT_S)
-        poses = self.world.own_ship.motion.poses(t_edges)
-        body = poses.rotation()  # body -> world, (C + 1, 3, 3)
         c, _, k, _ = directions_s.shape
         m = hdl32e.N_LASERS * k
-        # row-vector form keeps the (C, 32 K, 3) layout contiguous: d_world = d R^T, o_world = [o, 1] [R^T; p]
-        # (sensor -> world R^T of every edge in one product of (3 (C + 1), 3) rows)
-        rot_t = (body.reshape(-1, 3) @ self.mount_rotation).reshape(c + 1, 3, 3).transpose(0, 2, 1)
-        pos = poses.position_m + np.einsum("nij,j->ni", body, self.mount_translation)
-        a0 = np.empty((c, 4, 3))  # the affine map at each cycle start
-        da = np.empty((c, 4, 3))  # and its change over the cycle
-        a0[:, :3], a0[:, 3] = rot_t[:-1], pos[:-1]
-        np.subtract(rot_t[1:], rot_t[:-1], out=da[:, :3])
-        np.subtract(pos[1:], pos[:-1], out=da[:, 3])
+        a0, da = self._cycle_maps(cycle_time_s)
         # the fraction of the cycle at each firing, for every coordinate of its rays: (3 m,)
-        frac = np.repeat(np.arange(hdl32e.N_LASERS) * (hdl32e.FIRING_DT_S / hdl32e.CYCLE_DT_S), 3 * k)
+        frac = np.repeat(FIRING_FRACTION, 3 * k)
         d_world = directions_s.reshape(c, m, 3) @ a0[:, :3]
         _add_scaled(d_world, directions_s.reshape(c, m, 3) @ da[:, :3], frac)
         # origins in homogeneous coordinates [x, y, z, 1] (the same for every cycle)
@@ -273,8 +271,39 @@ class LidarRenderer:
         homogeneous[:, :3] = origins_s[0].reshape(-1, 3)
         o_world = homogeneous @ a0
         _add_scaled(o_world, homogeneous @ da, frac)
-        t_firing = cycle_time_s[:, None] + np.arange(hdl32e.N_LASERS)[None, :] * hdl32e.FIRING_DT_S
-        return o_world.reshape(c, hdl32e.N_LASERS, k, 3), d_world.reshape(c, hdl32e.N_LASERS, k, 3), t_firing
+        return o_world.reshape(c, hdl32e.N_LASERS, k, 3), d_world.reshape(c, hdl32e.N_LASERS, k, 3), _firing_times(cycle_time_s)
+
+    def _cycle_maps(self, cycle_time_s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The sensor -> world affine map at each cycle start and its change over the cycle, (C, 4, 3) each.
+
+        Row-vector form: ``[x, y, z, 1] @ map`` is the world point of sensor point ``(x, y, z)``
+        (rows 0-2 the rotation ``R^T``, row 3 the sensor's origin in the world, m).
+        """
+        t_edges = np.append(cycle_time_s, cycle_time_s[-1] + hdl32e.CYCLE_DT_S)
+        poses = self.world.own_ship.motion.poses(t_edges)
+        body = poses.rotation()  # body -> world, (C + 1, 3, 3)
+        c = cycle_time_s.shape[0]
+        # sensor -> world R^T of every edge in one product of (3 (C + 1), 3) rows
+        rot_t = (body.reshape(-1, 3) @ self.mount_rotation).reshape(c + 1, 3, 3).transpose(0, 2, 1)
+        pos = poses.position_m + np.einsum("nij,j->ni", body, self.mount_translation)
+        a0 = np.empty((c, 4, 3))  # the affine map at each cycle start
+        da = np.empty((c, 4, 3))  # and its change over the cycle
+        a0[:, :3], a0[:, 3] = rot_t[:-1], pos[:-1]
+        np.subtract(rot_t[1:], rot_t[:-1], out=da[:, :3])
+        np.subtract(pos[1:], pos[:-1], out=da[:, 3])
+        return a0, da
+
+    def _world_rays_compiled(self, cycle_time_s: np.ndarray, firing_azimuth: np.ndarray):
+        """:meth:`_world_rays` of one ray per beam, beams included, in one compiled pass (:mod:`raysim.jit`).
+
+        Returns (C, 32, 1, 3) origins (m) and directions in the world and (C, 32) firing times (s).
+        """
+        a0, da = self._cycle_maps(cycle_time_s)
+        o_world, d_world = lidar_kernels.world_rays(
+            firing_azimuth, hdl32e.COS_ELEVATION, hdl32e.SIN_ELEVATION, hdl32e.COS_AZIMUTH_STEP,
+            hdl32e.SIN_AZIMUTH_STEP, hdl32e.beam_origins()[:, 2], a0, da, FIRING_FRACTION)
+        c = cycle_time_s.shape[0]
+        return o_world.reshape(c, hdl32e.N_LASERS, 1, 3), d_world.reshape(c, hdl32e.N_LASERS, 1, 3), _firing_times(cycle_time_s)
 
     # ------------------------------------------------------------------ physics
 
@@ -284,8 +313,11 @@ class LidarRenderer:
         k = self.offsets.shape[0]
         f = c * hdl32e.N_LASERS
         n = f * k
-        origins_s, directions_s = self._sensor_rays(firing_azimuth)
-        o_w, d_w, t_firing = self._world_rays(cycle_time_s, origins_s, directions_s)
+        if jit.ENABLED and self.own_table is not None:  # one ray per beam, the own ship from its table
+            o_w, d_w, t_firing = self._world_rays_compiled(cycle_time_s, firing_azimuth)
+        else:
+            origins_s, directions_s = self._sensor_rays(firing_azimuth)
+            o_w, d_w, t_firing = self._world_rays(cycle_time_s, origins_s, directions_s)
         rays = _Rays(o_w.reshape(n, 3), d_w.reshape(n, 3),
                      np.repeat(t_firing.reshape(-1), k) if k > 1 else t_firing.reshape(-1))
         # candidate echoes per firing: K sub-rays and, in weather, one false echo near the sensor
