@@ -10,6 +10,7 @@ from __future__ import annotations
 import contextlib
 import datetime as dt
 import json
+import multiprocessing
 import platform
 import time
 from dataclasses import dataclass, field
@@ -28,6 +29,7 @@ from raysim.recording.jsonl import centre_positions_m, course_and_speed, write_o
 from raysim.recording.staging import StagedDirectory, atomic_path
 from raysim.scenario import Scenario, scenario_to_yaml
 from raysim.second_process import SecondProcess, can_start
+from raysim.sensors.lidar_run import ChunkClaims, join_pcap_parts, render_lidar_later_half
 from raysim.world import World
 
 TRUTH_RATE_HZ = 10.0  # docs/contracts.md: one truth line per object per 0.1 s
@@ -44,6 +46,8 @@ class RenderContext:
     counts: dict = field(default_factory=dict)
     wall_time_s: dict = field(default_factory=dict)
     _scene: object = None
+    #: In a second process rendering the LiDAR: the chunks it may render (raysim.sensors.lidar_run.ChunkClaims)
+    lidar_claims: object = None
 
     def scene(self):
         """The ray engine for the own ship's sensors (built once, shared by them)."""
@@ -315,9 +319,12 @@ def _render_sensors(ctx: RenderContext, scenario: Scenario, enabled, progress,
     names = [name for name in enabled if name in SENSOR_RENDERERS]
     not_available = [name for name in enabled if name not in SENSOR_RENDERERS]
     apart = "lidar" if "lidar" in names and len(names) > 1 and _second_process_wanted(processes, scenario) else None
+    claims = ChunkClaims.make(multiprocessing.get_context("spawn")) if apart else None
     wall: dict[str, float] = {}
+    started = time.perf_counter()
     with (_in_second_process(apart, SENSOR_RENDERERS[apart], ctx, progress,
-                             _sensor_plan(scenario, apart) + ", in a second process", lambda c: _made(c, sorted(c)))
+                             _sensor_plan(scenario, apart) + ", in a second process", lambda c: _made(c, sorted(c)),
+                             claims.shared if claims else None)
           if apart else contextlib.nullcontext({})) as lidar:
         for name in names:
             if name == apart:
@@ -327,8 +334,13 @@ def _render_sensors(ctx: RenderContext, scenario: Scenario, enabled, progress,
                 SENSOR_RENDERERS[name](ctx)
                 step.done = _made(ctx.counts, sorted(set(ctx.counts) - before))
             wall[name] = step.elapsed_s
+        if apart:  # the other sensors are done: this process renders the later half of the LiDAR still to do
+            lidar["later_half"] = render_lidar_later_half(ctx, claims)
     if apart:
-        wall[apart] = lidar["wall_s"]
+        join_pcap_parts(ctx.out_dir / "lidar")
+        for key, value in lidar["later_half"].items():
+            ctx.counts[key] += value
+        wall[apart] = time.perf_counter() - started
     ctx.wall_time_s.update((name, wall[name]) for name in names)  # in the sensors' order
     return names, not_available
 
@@ -340,12 +352,12 @@ def _second_process_wanted(processes: int, scenario: Scenario) -> bool:
 
 @contextlib.contextmanager
 def _in_second_process(name: str, renderer: Callable, ctx: RenderContext, progress: bool | None, what: str,
-                       done: Callable[[dict], str]) -> Iterator[dict]:
+                       done: Callable[[dict], str], claims=None) -> Iterator[dict]:
     """``renderer(ctx)`` in a second process (:class:`raysim.second_process.SecondProcess`) while the block
     runs, as the progress stage ``name``, which starts with the process and ends when it has finished; its
     counts join ``ctx.counts`` and the dict yielded gets ``"wall_s"``, the renderer's own wall time. The
     process is stopped if the block fails."""
-    child = SecondProcess(name, renderer, ctx)
+    child = SecondProcess(name, renderer, ctx, claims)
     try:
         with stage(name, progress, what) as step:
             timing: dict = {}

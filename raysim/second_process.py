@@ -56,13 +56,16 @@ class SecondProcess:
     ctx : raysim.render.RenderContext
         The render's context; the child works on a copy (pickled) without progress bars and with no
         ray engine (it builds its own).
+    claims : multiprocessing Array, optional
+        The chunks of a LiDAR run the child may render (:class:`raysim.sensors.lidar_run.ChunkClaims`),
+        inherited by the child as its context's ``lidar_claims`` (a shared array cannot go down a pipe).
     """
 
-    def __init__(self, name: str, renderer: Callable, ctx):
+    def __init__(self, name: str, renderer: Callable, ctx, claims=None):
         spawn = multiprocessing.get_context("spawn")
         self.name = name
         self._pipe, child_end = spawn.Pipe(duplex=True)
-        self._process = spawn.Process(target=_run, args=(renderer, child_end), name=f"raysim-{name}")
+        self._process = spawn.Process(target=_run, args=(renderer, child_end, claims), name=f"raysim-{name}")
         with _interrupts_ignored():  # inherited: Ctrl-C reaches the parent alone, which stops the child
             self._process.start()
         child_end.close()
@@ -116,7 +119,7 @@ def _interrupts_ignored():
         signal.signal(signal.SIGINT, previous)
 
 
-def _run(renderer: Callable, pipe) -> None:
+def _run(renderer: Callable, pipe, claims=None) -> None:
     """The child: the context from the pipe, render, then send back ("ok", (counts, wall time s)) or
     ("error", exception). A parent gone (stopped, killed) ends it quietly."""
     try:
@@ -125,6 +128,8 @@ def _run(renderer: Callable, pipe) -> None:
         os._exit(1)
     started = time.perf_counter()
     try:
+        if claims is not None:
+            ctx.lidar_claims = claims
         renderer(ctx)
         message = ("ok", (dict(ctx.counts), time.perf_counter() - started))
     except BaseException as exc:  # noqa: BLE001 - every failure goes back to the parent

@@ -144,11 +144,14 @@ class PcapWriter:
 
     HEADER = struct.pack("<IHHiIII", 0xA1B2C3D4, 2, 4, 0, 0, 65535, 1)
 
-    def __init__(self, handle: BinaryIO):
+    def __init__(self, handle: BinaryIO, header: bool = True, frames_before: int = 0):
+        """``header`` False and ``frames_before`` > 0: the records that follow ``frames_before`` others (a
+        file's later part, appended to it: the IP identification field continues their count)."""
         self.handle = handle
-        self.handle.write(self.HEADER)
+        if header:
+            self.handle.write(self.HEADER)
         self.frames = 0
-        self._ip_id = 0
+        self._ip_id = frames_before & 0xFFFF
 
     def write(self, frames: np.ndarray, unix_time_s: np.ndarray) -> None:
         """Append (N, L) uint8 frames captured at the (N,) float64 UNIX times given."""

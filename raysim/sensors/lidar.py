@@ -24,27 +24,20 @@ from groundfloor import hdl32e
 from groundfloor.frames import mount_transform  # noqa: F401 (raysim.sensors.lidar.mount_transform)
 from raysim import jit
 from raysim.materials import material_index, material_table
-from raysim.random_streams import stream
+from raysim.random_streams import chunk_stream, stream
 from raysim.recording import nmea
-from raysim.recording.staging import atomic_path
 from raysim.recording.velodyne import PcapWriter, encode_data_packets, encode_position_packet
 from raysim.scene import NO_HIT, SEA_ID, intersect_sea
 from raysim.sea import FoamField
-from raysim.sensors import lidar_kernels
 from raysim.sensors import lidar_physics as phys
 from raysim.sensors.blas_threads import single_blas_thread
 from raysim.sensors.carrier import CarrierScene
 from raysim.sensors.context import SensorContext
+from raysim.sensors.lidar_rays import CAST_RANGE_MARGIN_M, LidarGeometry
 from raysim.world import World
 
 SOURCE_OBJECT, SOURCE_SEA, SOURCE_WEATHER = 0, 1, 2
 FOAM_REFLECTANCE = 0.25  # whitecap foam at 905 nm, diffuse (unverified; bright in the visible, darker in NIR)
-#: Rays are cast this far past the maximum range, m, so that range noise can bring an echo just
-#: beyond it back in (the measured range is checked against the maximum after the noise).
-CAST_RANGE_MARGIN_M = 1.0
-#: Own-ship hits below this height above the waterline, m, may have the sea in front of them when
-#: the ship rolls or heaves; those beams are checked against the sea at each firing.
-WET_HIT_MAX_Z_M = 1.0
 #: Largest value of the packets' 16-bit distance field, 2 mm units (HDL-32E user manual, 131.07 m).
 MAX_DISTANCE_UNITS = 65535
 #: Diffuse reflectivity byte per unit of apparent reflectance (0..100,
@@ -60,8 +53,6 @@ CYCLE_COUNT_SLACK = 1e-9
 SECONDS_PER_HOUR = 3600.0
 MICROSECONDS_PER_SECOND = 1e6
 DEG_PER_TURN = 360.0
-#: Each laser's firing instant as a fraction of the 46.08 us cycle, (32,).
-FIRING_FRACTION = np.arange(hdl32e.N_LASERS) * (hdl32e.FIRING_DT_S / hdl32e.CYCLE_DT_S)
 
 
 @dataclass
@@ -133,24 +124,7 @@ class LidarChunk:
     position_times_s: list
 
 
-def _firing_times(cycle_time_s: np.ndarray) -> np.ndarray:
-    """(C, 32) time of each firing of C cycles, s."""
-    return cycle_time_s[:, None] + np.arange(hdl32e.N_LASERS)[None, :] * hdl32e.FIRING_DT_S
-
-
-def _add_scaled(total: np.ndarray, change: np.ndarray, scale: np.ndarray) -> None:
-    """``total += change * scale`` in place, over rows: total, change (C, M, 3); scale (3 M,).
-
-    Each cycle's row of 3 M values is one pass (a broadcast over the last axis of 3 would step
-    three values at a time); ``change`` is overwritten.
-    """
-    flat_total, flat = total.view(), change.view()
-    flat_total.shape = flat.shape = (total.shape[0], -1)  # views (an error, never a silent copy)
-    np.multiply(flat, scale, out=flat)
-    np.add(flat_total, flat, out=flat_total)
-
-
-class LidarRenderer:
+class LidarRenderer(LidarGeometry):
     """Renders the HDL-32E of a world's own ship.
 
     Parameters
@@ -172,8 +146,8 @@ class LidarRenderer:
         self.threshold = phys.detection_threshold(self.cfg.detection_reflectance)
         self.foam = FoamField(s.environment.wind_speed_mps, s.environment.sea_state, s.environment.wind_from_deg,
                               stream(s.seed, "sea.foam"))
-        self.noise_rng = stream(s.seed, "lidar.range_noise")
-        self.weather_rng = stream(s.seed, "lidar.weather")
+        self.noise_rng = chunk_stream(s.seed, "lidar.range_noise", 0)  # chunks() gives each chunk its own
+        self.weather_rng = chunk_stream(s.seed, "lidar.weather", 0)
         self.materials = material_table()
         self.sea_material = material_index("sea")
         self.offsets = phys.sub_ray_offsets(self.cfg.sub_rays, self.cfg.beam_divergence_mrad * 1e-3)
@@ -183,129 +157,6 @@ class LidarRenderer:
         self.n_packets = self.n_cycles // self.cycles_per_packet
         #: (scenario seconds, wall seconds) of each chunk of the last run (benchmarks read it)
         self.chunk_wall_s: list[tuple[float, float]] = []
-
-    # ------------------------------------------------------------------ geometry
-
-    def _own_ship_table(self):
-        """Own-ship hits of every beam the sensor can fire: 36000 encoder steps x 32 lasers.
-
-        The own ship is rigid and the mount fixed, so in the body frame these rays never
-        change: they are cast once here and looked up for every firing. Kept compact:
-        per beam the range, the echo's relative power and reflectivity byte (all constant:
-        the incidence and material do not change), and whether the hit is low enough on
-        the hull for the sea to come first.
-        """
-        if self.scene is None or self.scene.carrier is None:
-            return None
-        steps = hdl32e.CENTIDEG_PER_TURN
-        az = np.broadcast_to(np.arange(steps, dtype=np.uint16)[:, None], (steps, hdl32e.N_LASERS))
-        origins, directions = self._sensor_rays(az)
-        n = origins.shape[0] * hdl32e.N_LASERS
-        o_b = origins.reshape(n, 3) @ self.mount_rotation.T + self.mount_translation
-        d_b = directions.reshape(n, 3) @ self.mount_rotation.T
-        hits = self.scene.carrier_hits(o_b, d_b, max_range_m=self.cfg.range_max_m + CAST_RANGE_MARGIN_M)
-        hit = hits.object_id != NO_HIT
-        cos_inc = np.abs(np.einsum("ij,ij->i", hits.normal, d_b))
-        mat = np.where(hit, hits.material, 0)
-        reflectance = np.where(hit, self.materials["reflectance_905nm"][mat], 0.0)
-        rng = np.where(hit, hits.range_m, np.inf)
-        hit_z = o_b[:, 2] + np.where(hit, hits.range_m, 0.0) * d_b[:, 2]
-        return {
-            "hit": hit,
-            "range_m": rng.astype(np.float32),
-            "power": np.where(hit, phys.echo_power(reflectance * cos_inc, rng, self.alpha), 0.0).astype(np.float32),
-            "byte": phys.reflectivity_byte(reflectance, cos_inc, self.materials["retroreflective"][mat] & hit),
-            # hits near or below the waterline: the sea may come first when the ship rolls or heaves
-            "wet": hit & (hit_z < WET_HIT_MAX_Z_M),
-            "object_id": self.world.own_ship.object_id,
-        }
-
-    def _sensor_rays(self, firing_azimuth: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Sensor-frame beam origins and directions, (C, 32, K, 3) each (K sub-rays)."""
-        axis = hdl32e.beam_directions(firing_azimuth)  # (C, 32, 3)
-        if self.offsets.shape[0] == 1:
-            directions = axis[:, :, None, :]
-        else:
-            # perpendicular unit vectors: u horizontal (azimuth direction), v up-ish
-            u = np.stack([-axis[..., 1], axis[..., 0], np.zeros(axis.shape[:-1])], axis=-1)
-            u /= np.linalg.norm(u, axis=-1, keepdims=True)
-            v = np.cross(axis, u)
-            directions = (axis[:, :, None, :] + self.offsets[None, None, :, 0, None] * u[:, :, None, :]
-                          + self.offsets[None, None, :, 1, None] * v[:, :, None, :])
-            directions /= np.linalg.norm(directions, axis=-1, keepdims=True)
-        origins = np.broadcast_to(hdl32e.beam_origins()[None, :, None, :], directions.shape)
-        return origins, directions
-
-    def _world_rays(self, cycle_time_s: np.ndarray, origins_s: np.ndarray, directions_s: np.ndarray):
-        """Rays in the world at each firing's own instant.
-
-        The own-ship pose is evaluated at the C cycle starts and the next one, and
-        interpolated linearly to each firing (1.152 us steps): the error of that
-        interpolation over 46 us is below 1e-9 rad.
-
-        Parameters
-        ----------
-        cycle_time_s : (C,) float64
-            Start of each firing cycle, s.
-        origins_s, directions_s : (C, 32, K, 3) float64
-            Beam origins (m) and unit directions in the sensor frame.
-
-        Returns
-        -------
-        o_world : (C, 32, K, 3) float64
-            Ray origins in the world, m.
-        d_world : (C, 32, K, 3) float64
-            Unit ray directions in the world.
-        t_firing : (C, 32) float64
-            Time of each firing, s.
-        """
-        c, _, k, _ = directions_s.shape
-        m = hdl32e.N_LASERS * k
-        a0, da = self._cycle_maps(cycle_time_s)
-        # the fraction of the cycle at each firing, for every coordinate of its rays: (3 m,)
-        frac = np.repeat(FIRING_FRACTION, 3 * k)
-        d_world = directions_s.reshape(c, m, 3) @ a0[:, :3]
-        _add_scaled(d_world, directions_s.reshape(c, m, 3) @ da[:, :3], frac)
-        # origins in homogeneous coordinates [x, y, z, 1] (the same for every cycle)
-        homogeneous = np.ones((m, 4))
-        homogeneous[:, :3] = origins_s[0].reshape(-1, 3)
-        o_world = homogeneous @ a0
-        _add_scaled(o_world, homogeneous @ da, frac)
-        return o_world.reshape(c, hdl32e.N_LASERS, k, 3), d_world.reshape(c, hdl32e.N_LASERS, k, 3), _firing_times(cycle_time_s)
-
-    def _cycle_maps(self, cycle_time_s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The sensor -> world affine map at each cycle start and its change over the cycle, (C, 4, 3) each.
-
-        Row-vector form: ``[x, y, z, 1] @ map`` is the world point of sensor point ``(x, y, z)``
-        (rows 0-2 the rotation ``R^T``, row 3 the sensor's origin in the world, m).
-        """
-        t_edges = np.append(cycle_time_s, cycle_time_s[-1] + hdl32e.CYCLE_DT_S)
-        poses = self.world.own_ship.motion.poses(t_edges)
-        body = poses.rotation()  # body -> world, (C + 1, 3, 3)
-        c = cycle_time_s.shape[0]
-        # sensor -> world R^T of every edge in one product of (3 (C + 1), 3) rows
-        rot_t = (body.reshape(-1, 3) @ self.mount_rotation).reshape(c + 1, 3, 3).transpose(0, 2, 1)
-        pos = poses.position_m + np.einsum("nij,j->ni", body, self.mount_translation)
-        a0 = np.empty((c, 4, 3))  # the affine map at each cycle start
-        da = np.empty((c, 4, 3))  # and its change over the cycle
-        a0[:, :3], a0[:, 3] = rot_t[:-1], pos[:-1]
-        np.subtract(rot_t[1:], rot_t[:-1], out=da[:, :3])
-        np.subtract(pos[1:], pos[:-1], out=da[:, 3])
-        return a0, da
-
-    def _world_rays_compiled(self, cycle_time_s: np.ndarray, firing_azimuth: np.ndarray):
-        """:meth:`_world_rays` of one ray per beam, beams included, in one compiled pass (:mod:`raysim.jit`).
-
-        Returns (C, 32, 1, 3) origins (m) and directions in the world and (C, 32) firing times (s).
-        """
-        a0, da = self._cycle_maps(cycle_time_s)
-        o_world, d_world = lidar_kernels.world_rays(
-            firing_azimuth, hdl32e.COS_ELEVATION, hdl32e.SIN_ELEVATION, hdl32e.COS_AZIMUTH_STEP,
-            hdl32e.SIN_AZIMUTH_STEP, hdl32e.beam_origins()[:, 2], a0, da, FIRING_FRACTION)
-        c = cycle_time_s.shape[0]
-        return o_world.reshape(c, hdl32e.N_LASERS, 1, 3), d_world.reshape(c, hdl32e.N_LASERS, 1, 3), _firing_times(cycle_time_s)
-
-    # ------------------------------------------------------------------ physics
 
     def measure(self, cycle_time_s: np.ndarray, block_azimuth: np.ndarray, firing_azimuth: np.ndarray) -> Firings:
         """Cast and measure C firing cycles."""
@@ -539,20 +390,50 @@ class LidarRenderer:
 
     # ------------------------------------------------------------------ the run
 
-    def chunks(self, progress=None):
-        """Render the scenario a chunk (about one revolution) at a time, in time order.
+    @property
+    def chunk_packets(self) -> int:
+        """Data packets of a chunk: the fewest that hold a revolution."""
+        return max(1, int(np.ceil(hdl32e.cycles_per_revolution(self.cfg.rotation_hz) / self.cycles_per_packet)))
+
+    @property
+    def n_chunks(self) -> int:
+        """Chunks of the whole run (the last may be short)."""
+        return -(-self.n_packets // self.chunk_packets)
+
+    def chunk_start_s(self, index: int) -> float:
+        """Start of chunk ``index`` (``n_chunks``: the end of the run), s."""
+        return min(index * self.chunk_packets, self.n_packets) * self.cycles_per_packet * hdl32e.CYCLE_DT_S
+
+    def chunks(self, progress=None, first: int = 0, end: int | None = None, claim=None):
+        """Render chunks ``first .. end - 1`` (about one revolution each; all by default) in time order.
+
+        Each chunk draws its range noise and weather from its own random streams
+        (:func:`raysim.random_streams.chunk_stream`), so a chunk's bytes do not depend on which
+        chunks were rendered before it, nor in which process.
+
+        Parameters
+        ----------
+        progress : callable, optional
+            Wraps the iterable of chunk indices (a progress bar).
+        first, end : int
+            The chunks to render (``end`` None: to the end of the run).
+        claim : callable, optional
+            ``claim(index) -> bool``, asked before each chunk: False stops the render there
+            (:class:`raysim.sensors.lidar_run.ChunkClaims`, two processes sharing a run).
 
         Yields
         ------
         LidarChunk
             The chunk's firings, data packets and their send times, and the position packets due in it.
         """
-        rev_cycles = hdl32e.cycles_per_revolution(self.cfg.rotation_hz)
-        chunk_packets = max(1, int(np.ceil(rev_cycles / self.cycles_per_packet)))
-        next_position_s = 0.0
-        starts = range(0, self.n_packets, chunk_packets)
-        for first_packet in (progress(starts) if progress else starts):
+        chunk_packets = self.chunk_packets
+        next_position_s = self._positions_before(first)
+        indices = range(first, self.n_chunks if end is None else min(end, self.n_chunks))
+        for index in (progress(indices) if progress else indices):
+            if claim is not None and not claim(index):
+                return
             chunk_started = time.perf_counter()
+            first_packet = index * chunk_packets
             packets_here = min(chunk_packets, self.n_packets - first_packet)
             k0 = first_packet * self.cycles_per_packet
             cycles = k0 + np.arange(packets_here * self.cycles_per_packet)
@@ -562,6 +443,9 @@ class LidarRenderer:
             az_blocks = (np.repeat(block_az, DUAL_RETURNS) if self.dual else block_az).reshape(-1, blocks)
             firing_az = hdl32e.decoder_azimuths_centideg(az_blocks, dual=self.dual)
             firing_az = firing_az[:, ::2] if self.dual else firing_az
+            seed = self.world.scenario.seed
+            self.noise_rng = chunk_stream(seed, "lidar.range_noise", index)
+            self.weather_rng = chunk_stream(seed, "lidar.weather", index)
             with single_blas_thread():  # the chunk's matrix products are small (raysim.sensors.blas_threads)
                 fire = self.measure(t, block_az, firing_az.reshape(-1, hdl32e.N_LASERS))
             payloads = self.packets(fire)
@@ -575,22 +459,22 @@ class LidarRenderer:
             yield LidarChunk(t, fire, payloads, sent, position_times)
             self.chunk_wall_s.append((t_end - t[0], time.perf_counter() - chunk_started))
 
+    def _positions_before(self, first: int) -> float:
+        """The time of the first position packet of chunk ``first``, s, summed as the chunks before it sum it."""
+        next_position_s = 0.0
+        if first == 0 or self.cfg.position_packet_rate_hz <= 0:
+            return next_position_s
+        # the end of chunk first - 1 exactly as chunks() computes it: its last cycle's start plus a cycle
+        t_end = (first * self.chunk_packets * self.cycles_per_packet - 1) * hdl32e.CYCLE_DT_S + hdl32e.CYCLE_DT_S
+        while next_position_s < t_end:
+            next_position_s += 1.0 / self.cfg.position_packet_rate_hz
+        return next_position_s
+
     def run(self, out_dir: Path, progress=None) -> dict:
         """Render the whole scenario into ``out_dir/lidar``; returns counts for the manifest."""
-        from raysim.sensors.lidar_sweeps import LidarSweeps
+        from raysim.sensors.lidar_run import render_chunks
 
-        lidar_dir = out_dir / "lidar"
-        sweeps = LidarSweeps(self, lidar_dir / "sweeps")
-        counts = {"packets": 0, "position_packets": 0}
-        with atomic_path(lidar_dir / "hdl32e.pcap") as tmp, open(tmp, "wb") as handle:
-            pcap = PcapWriter(handle)
-            for chunk in self.chunks(progress):
-                self._write_in_order(pcap, chunk.payloads, chunk.sent_s, chunk.position_times_s)
-                counts["packets"] += chunk.payloads.shape[0]
-                counts["position_packets"] += len(chunk.position_times_s)
-                sweeps.add(chunk)
-            sweeps.finish()
-        return {**counts, **sweeps.counts}
+        return render_chunks(self, out_dir, progress)
 
     def _write_in_order(self, pcap: PcapWriter, payloads: np.ndarray, sent: np.ndarray, position_times: list[float]) -> None:
         if not position_times:
@@ -607,12 +491,9 @@ class LidarRenderer:
         if cut < payloads.shape[0]:
             pcap.write_udp(payloads[cut:], hdl32e.DATA_PORT, self.start_unix_s + sent[cut:])
 
-def render_lidar(ctx: SensorContext) -> None:
-    """The ``lidar`` entry of :data:`raysim.render.SENSOR_RENDERERS`."""
-    scene = ctx.scene()
-    renderer = LidarRenderer(ctx.world, scene)
-    from tqdm import tqdm
 
-    progress = (lambda it: tqdm(it, desc="lidar", unit="rev", leave=False)) if ctx.progress else None
-    counts = renderer.run(ctx.out_dir, progress)
-    ctx.counts.update({f"lidar/{k}": v for k, v in counts.items()})
+def render_lidar(ctx: SensorContext) -> None:
+    """The ``lidar`` entry of :data:`raysim.render.SENSOR_RENDERERS` (:func:`raysim.sensors.lidar_run.render_lidar`)."""
+    from raysim.sensors.lidar_run import render_lidar as render
+
+    render(ctx)

@@ -27,15 +27,22 @@ class LidarSweeps:
     renderer : raysim.sensors.lidar.LidarRenderer
     sweeps_dir : Path
         Where ``NNNNNN.npz`` go (created).
+    first_revolution : int
+        Revolutions before this one are not written (a later part of a run: their points are
+        another part's).
     """
 
-    def __init__(self, renderer, sweeps_dir: Path):
+    def __init__(self, renderer, sweeps_dir: Path, first_revolution: int = 0):
         self.renderer = renderer
         self.sweeps_dir = Path(sweeps_dir)
         self.sweeps_dir.mkdir(parents=True, exist_ok=True)
         self.pending: list[dict] = []
-        self.current = 0
+        self.first_revolution = self.current = int(first_revolution)
         self.counts = {"sweeps": 0, "points": 0}
+
+    def revolution_at(self, t_s: float) -> int:
+        """The revolution under way at time ``t_s``, s."""
+        return int(self._revolution(np.array([t_s]))[0])
 
     def _revolution(self, t_s: np.ndarray) -> np.ndarray:
         cfg = self.renderer.cfg
@@ -53,16 +60,18 @@ class LidarSweeps:
         # first point of each revolution of the chunk (its cycles are in time order, so are the points)
         cut = np.searchsorted(np.take(revolution, cycle_of_point), revs, side="left").tolist() + [cycle_of_point.size]
         for i, rev in enumerate(revs):
+            if rev < self.first_revolution:
+                continue
             if rev > self.current:
                 self._flush()
                 self.pending, self.current = [], int(rev)
             self.pending.append({k: v[cut[i]:cut[i + 1]] for k, v in pts.items()})
 
-    def finish(self) -> None:
-        """Write the last revolution if the render completed it."""
+    def finish(self, end_s: float | None = None) -> None:
+        """Write the last revolution if the render completed it (before ``end_s``: by default the run's end)."""
         r = self.renderer
-        t_next = np.array([r.n_packets * r.cycles_per_packet * hdl32e.CYCLE_DT_S])
-        if self.pending and self._revolution(t_next)[0] > self.current:
+        end_s = r.n_packets * r.cycles_per_packet * hdl32e.CYCLE_DT_S if end_s is None else end_s
+        if self.pending and self._revolution(np.array([end_s]))[0] > self.current:
             self._flush()
 
     def _flush(self) -> None:

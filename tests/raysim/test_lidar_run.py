@@ -1,0 +1,84 @@
+"""raysim.sensors.lidar_run: a LiDAR run rendered in two parts is the same recording as one rendered whole."""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import multiprocessing
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from raysim.materials import material_index
+from raysim.scenario import load_scenario, with_overrides
+from raysim.sensors.carrier import CarrierScene
+from raysim.sensors.lidar import LidarRenderer
+from raysim.sensors.lidar_run import ChunkClaims, MIN_CHUNKS_TO_SHARE, join_pcap_parts, render_chunks
+from raysim.world import World
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _renderer(duration_s: float, **lidar) -> LidarRenderer:
+    s = load_scenario(ROOT / "scenarios" / "busy_open_sea.yaml")
+    if lidar:
+        s = dataclasses.replace(s, sensors=dataclasses.replace(s.sensors, lidar=dataclasses.replace(s.sensors.lidar, **lidar)))
+    s = with_overrides(s, duration_s=duration_s, sensors=("lidar",))
+    world = World(s)
+    return LidarRenderer(world, CarrierScene(world.scene_objects(), sea_material=material_index("sea")))
+
+
+def _digests(root: Path) -> dict[str, str]:
+    return {str(p.relative_to(root)): hashlib.md5(p.read_bytes()).hexdigest() for p in sorted(root.rglob("*")) if p.is_file()}
+
+
+@pytest.fixture(scope="module")
+def whole(tmp_path_factory):
+    """busy_open_sea, 1.05 s (11 chunks, the last one short), rendered in one go."""
+    out = tmp_path_factory.mktemp("whole")
+    counts = render_chunks(_renderer(1.05), out)
+    return out, counts
+
+
+@pytest.mark.parametrize("split", [1, 5, 10])
+def test_two_parts_are_the_whole_run(whole, tmp_path, split):
+    out, counts = whole
+    renderer = _renderer(1.05)
+    assert renderer.n_chunks == 11
+    early = render_chunks(renderer, tmp_path, end=split)
+    late = render_chunks(_renderer(1.05), tmp_path, first=split)
+    assert list((tmp_path / "lidar").glob(".hdl32e.pcap.part-*"))
+    join_pcap_parts(tmp_path / "lidar")
+    assert _digests(tmp_path) == _digests(out)  # every packet, position packet, sweep byte
+    assert {k: early[k] + late[k] for k in counts} == counts
+    assert counts["sweeps"] == 10 and counts["position_packets"] == 2
+
+
+def test_a_chunk_does_not_depend_on_the_chunks_before_it():
+    """Chunk 7 rendered alone is chunk 7 of the whole run (its noise is its own), and the noise is real."""
+    all_chunks = list(_renderer(1.0).chunks())
+    alone = next(_renderer(1.0).chunks(first=7))
+    assert alone.payloads.tobytes() == all_chunks[7].payloads.tobytes()
+    # two chunks' noise streams differ: the same geometry would give different millimetres
+    assert not np.array_equal(all_chunks[6].firings.distance_units, all_chunks[7].firings.distance_units)
+
+
+def test_dual_returns_in_two_parts(tmp_path):
+    one, two = tmp_path / "one", tmp_path / "two"
+    render_chunks(_renderer(0.6, return_mode="dual"), one)
+    render_chunks(_renderer(0.6, return_mode="dual"), two, end=3)
+    render_chunks(_renderer(0.6, return_mode="dual"), two, first=3)
+    join_pcap_parts(two / "lidar")
+    assert _digests(one) == _digests(two)
+
+
+def test_claims_split_what_is_left():
+    claims = ChunkClaims.make(multiprocessing.get_context("spawn"))
+    assert all(claims.claim(i) for i in range(10))  # the second process has rendered chunks 0-9
+    assert claims.take_later_half(30) == (20, 30)  # 20 left: this process takes the later 10
+    assert claims.claim(19) and not claims.claim(20)  # and the second process stops before them
+    late = ChunkClaims.make(multiprocessing.get_context("spawn"))
+    for i in range(30 - MIN_CHUNKS_TO_SHARE + 1):
+        late.claim(i)
+    assert late.take_later_half(30) == (30, 30)  # too few left to share: all the second process's
