@@ -22,6 +22,7 @@ from PIL import Image, ImageDraw, ImageFont
 from groundfloor.frames import LocalFrame
 from raysim.recording.jsonl import row_centre_xy, truth_epochs
 from raysim.recording.land_picture import LandOutline, clip_shoreline, read_land
+from raysim.recording.npz import read_npz
 from raysim.recording.staging import atomic_path
 
 __all__ = ["write_bev"]
@@ -125,8 +126,8 @@ def write_bev(recording: Path, scenario) -> int:
         return 0
     starts = {}
     for path in chosen:
-        with np.load(path) as sweep:
-            starts[path] = round(float(sweep["time"].min()) * 10.0) / 10.0 if sweep["time"].size else 0.0
+        times = read_npz(path)["time"]
+        starts[path] = round(float(times.min()) * 10.0) / 10.0 if times.size else 0.0
     wanted = set(starts.values())
     truth = dict(truth_epochs(recording / "truth.jsonl", wanted.__contains__))
     mount = scenario.sensors.lidar.mount
@@ -135,8 +136,8 @@ def write_bev(recording: Path, scenario) -> int:
     scale = SIZE_PX / (2 * HALF_RANGE_M)
     land = read_land(recording, LocalFrame(scenario.origin.lat, scenario.origin.lon)) if scenario.land else []
     for path in chosen:
-        with np.load(path) as sweep:
-            x, y, intensity = sweep["x"], sweep["y"], sweep["intensity"]
+        sweep = read_npz(path)
+        x, y, intensity = sweep["x"], sweep["y"], sweep["intensity"]
         image = np.zeros((SIZE_PX, SIZE_PX, 3), dtype=np.uint8)
         col = np.floor(SIZE_PX / 2 - y * scale).astype(np.int64)  # y (left) to the left
         row = np.floor(SIZE_PX / 2 - x * scale).astype(np.int64)  # x (forward) up

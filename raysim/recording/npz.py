@@ -14,6 +14,8 @@ one ``numpy.lib.format.write_array`` and ``ZipFile.writestr`` would give
 from __future__ import annotations
 
 import io
+import re
+import struct
 import zipfile
 from pathlib import Path
 from typing import Mapping, Sequence
@@ -85,3 +87,60 @@ def write_sweep_pieces(sweeps_dir: Path, number: int, schema: SweepSchema,
             raise ValueError(f"{schema.sensor} sweep: the pieces of {name} differ in dtype or shape")
     schema.conform({name: parts[0] for name, parts in pieces.items()})
     write_npz_pieces(Path(sweeps_dir) / sweep_file_name(number), pieces)
+
+
+_LOCAL_HEADER = struct.Struct("<4sHHHHHIIIHH")  # ZIP local file header (APPNOTE 4.3.7), 30 bytes
+_NPY_HEADER = re.compile(rb"\{'descr': '([<>|][a-zA-Z]\d+)', 'fortran_order': False, 'shape': \(([\d, ]*)\), \}")
+_NPY_MAGIC = b"\x93NUMPY\x01\x00"
+
+
+def read_npz(path: Path) -> dict[str, np.ndarray]:
+    """Every array of an .npz file, read in one pass: views on the file's bytes, no copies.
+
+    The files this module writes (stored members, ``.npy`` format 1.0, C order) are parsed here
+    directly: ``np.load`` spends most of a small sweep's read on the zip directory, a CRC of every
+    member and a Python parse of every header. Any other file (compressed, another writer's, a
+    format this parser does not know) is read with ``np.load``, as are the files whose members do
+    not check out. For files this run wrote (the bag, the pictures); the TDM's readers check more.
+    """
+    data = Path(path).read_bytes()
+    arrays = _parse_stored(data)
+    if arrays is None:
+        with np.load(io.BytesIO(data)) as archive:
+            arrays = {name: archive[name] for name in archive.files}
+    return arrays
+
+
+def _parse_stored(data: bytes) -> dict[str, np.ndarray] | None:
+    """The members of a stored .npz image as arrays, or None where anything is not as this writer writes it."""
+    arrays: dict[str, np.ndarray] = {}
+    at, size = 0, len(data)
+    while at + _LOCAL_HEADER.size <= size and data[at:at + 4] == b"PK\x03\x04":
+        _, _, flags, method, _, _, _, csize, usize, name_len, extra_len = _LOCAL_HEADER.unpack_from(data, at)
+        start = at + _LOCAL_HEADER.size + name_len + extra_len
+        name = data[at + _LOCAL_HEADER.size:at + _LOCAL_HEADER.size + name_len].decode("utf-8", "replace")
+        if method != 0 or flags & 0x08 or csize != usize or start + csize > size or not name.endswith(".npy"):
+            return None
+        array = _parse_npy(data, start, csize)
+        if array is None:
+            return None
+        arrays[name[:-4]] = array
+        at = start + csize
+    return arrays if arrays and data[at:at + 4] == b"PK\x01\x02" else None
+
+
+def _parse_npy(data: bytes, start: int, length: int) -> np.ndarray | None:
+    """An ``.npy`` format 1.0 image at ``data[start:start + length]`` as a read-only view, or None."""
+    if data[start:start + 8] != _NPY_MAGIC:
+        return None
+    header_len = int.from_bytes(data[start + 8:start + 10], "little")
+    match = _NPY_HEADER.match(data, start + 10, start + 10 + header_len)
+    if match is None:
+        return None
+    dtype = np.dtype(match.group(1).decode("ascii"))
+    shape = tuple(int(v) for v in match.group(2).split(b",") if v.strip())
+    count = int(np.prod(shape, dtype=np.int64))
+    offset = start + 10 + header_len
+    if offset + count * dtype.itemsize != start + length:
+        return None
+    return np.frombuffer(data, dtype=dtype, count=count, offset=offset).reshape(shape)

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from raysim.recording.npz import read_npz
 from raysim.recording.staging import atomic_path
 
 __all__ = ["FORMATS", "PCD_DTYPE", "velodyne_points", "pcd_bytes", "kitti_bytes", "write_point_cloud_files"]
@@ -68,8 +69,7 @@ def write_point_cloud_files(recording: Path, formats: tuple[str, ...]) -> dict:
         folder = Path(recording) / "lidar" / name
         folder.mkdir(parents=True, exist_ok=True)
         for path in sweeps:  # one file per revolution, one at a time (memory flat)
-            with np.load(path) as sweep:
-                data = to_bytes(sweep)
+            data = to_bytes(read_npz(path))
             with atomic_path(folder / f"{path.stem}.{ext}") as tmp:
                 tmp.write_bytes(data)
         counts[f"lidar/{name}"] = len(sweeps)

@@ -62,3 +62,32 @@ def test_sweep_pieces_keep_the_contract(tmp_path):
         npz.write_sweep_pieces(tmp_path, 4, LIDAR_SWEEP, {**good, "x": [np.zeros(2, np.float64)] * 2})
     with pytest.raises(ValueError):
         npz.write_sweep_pieces(tmp_path, 5, LIDAR_SWEEP, {**good, "x": [np.zeros(2, np.float32), np.zeros(2, np.float64)]})
+
+
+# ---------------------------------------------------------------------- the one-pass reader
+
+
+def test_read_npz_gives_what_np_load_gives(tmp_path):
+    """Every dtype, shape (empty, scalar, 2-d, big-endian) of this writer's files: the same arrays as np.load."""
+    arrays = {**ARRAYS, "grid": np.arange(24, dtype=np.int16).reshape(4, 6), ">f8": np.arange(5, dtype=">f8")}
+    npz.write_npz(tmp_path / "a.npz", arrays)
+    read = npz.read_npz(tmp_path / "a.npz")
+    with np.load(tmp_path / "a.npz") as reference:
+        assert list(read) == reference.files
+        for name in reference.files:
+            assert read[name].dtype == reference[name].dtype and read[name].shape == reference[name].shape
+            assert np.array_equal(read[name], reference[name])
+
+
+def test_read_npz_of_other_writers_falls_back_to_np_load(tmp_path, monkeypatch):
+    """A compressed .npz (numpy's savez_compressed) is not parsed here but read by np.load, to the same arrays."""
+    np.savez_compressed(tmp_path / "c.npz", x=np.arange(100.0), y=np.ones((3, 3), dtype=np.uint8))
+    assert npz._parse_stored((tmp_path / "c.npz").read_bytes()) is None
+    read = npz.read_npz(tmp_path / "c.npz")
+    assert np.array_equal(read["x"], np.arange(100.0)) and read["y"].shape == (3, 3)
+    # and a member whose header says more data than it holds is not trusted either
+    npz.write_npz(tmp_path / "s.npz", {"x": np.arange(10.0)})
+    data = bytearray((tmp_path / "s.npz").read_bytes())
+    at = data.index(b"(10,)")
+    data[at:at + 5] = b"(11,)"
+    assert npz._parse_stored(bytes(data)) is None

@@ -15,6 +15,7 @@ import numpy as np
 
 from groundfloor.frames import mount_transform
 from groundfloor.recording import AIS_NMEA, LIDAR_SWEEPS, RADAR_SWEEPS
+from raysim.recording.npz import read_npz
 from raysim.recording.pointclouds import PCD_DTYPE, velodyne_points
 from raysim.recording.rosbag.msgs import BagMessage, duration, header, make, point, quaternion, quaternion_from_matrix
 
@@ -48,10 +49,10 @@ def lidar_clouds(recording: Path, ns_of: NsOf) -> Iterator[BagMessage]:
     """``/lidar/points``: one PointCloud2 per revolution in the velodyne driver's layout, frame ``lidar``."""
     fields = [make("sensor_msgs/msg/PointField", name=n, offset=o, datatype=d, count=1) for n, o, d in _CLOUD_FIELDS]
     for path in sorted((recording / LIDAR_SWEEPS).glob("*.npz")):
-        with np.load(path) as sweep:
-            points = velodyne_points(sweep)
-            n = points.size
-            t_ns = ns_of(float(sweep["time"].min()) if n else 0.0)
+        sweep = read_npz(path)
+        points = velodyne_points(sweep)
+        n = points.size
+        t_ns = ns_of(float(sweep["time"].min()) if n else 0.0)
         msg = make("sensor_msgs/msg/PointCloud2", header=header(t_ns, "lidar"), height=1, width=n, fields=fields,
                    is_bigendian=False, point_step=POINT_STEP, row_step=POINT_STEP * n, data=points.view(np.uint8),
                    is_dense=True)
@@ -65,8 +66,8 @@ def radar_sectors(recording: Path, ns_of: NsOf) -> Iterator[BagMessage]:
     """
     ppi_dir = recording / "radar" / "ppi"
     for path in sorted((recording / RADAR_SWEEPS).glob("*.npz")):
-        with np.load(path) as sweep:
-            echo, az, times, rng = sweep["echo"], sweep["azimuth_deg"], sweep["time"], sweep["range_m"]
+        sweep = read_npz(path)
+        echo, az, times, rng = sweep["echo"], sweep["azimuth_deg"], sweep["time"], sweep["range_m"]
         spokes = echo.shape[0]
         dt = float(times[1] - times[0]) if spokes > 1 else 0.0
         t_ns = ns_of(float(times[0]))
