@@ -95,31 +95,57 @@ _NUMPY = {"bool": np.bool_, "int8": np.int8, "uint8": np.uint8, "byte": np.uint8
 
 def _default(kind):
     """Default value of a field description of the typestore (zeros, empty strings and sequences)."""
-    from rosbags.interfaces import Nodetype
-
     node, detail = kind
-    if node == Nodetype.BASE:
+    nodetype = _nodetype()
+    if node == nodetype.BASE:
         name = detail[0]
         return "" if name == "string" else False if name == "bool" else 0.0 if name.startswith("float") else 0
-    if node == Nodetype.NAME:
+    if node == nodetype.NAME:
         return make(detail)
-    if node == Nodetype.ARRAY:
+    if node == nodetype.ARRAY:
         (sub, size) = detail
-        if sub[0] == Nodetype.BASE and sub[1][0] in _NUMPY:
+        if sub[0] == nodetype.BASE and sub[1][0] in _NUMPY:
             return np.zeros(size, dtype=_NUMPY[sub[1][0]])
         return [_default(sub) for _ in range(size)]
     sub = detail[0]
-    if sub[0] == Nodetype.BASE and sub[1][0] in _NUMPY:
+    if sub[0] == nodetype.BASE and sub[1][0] in _NUMPY:
         return np.zeros(0, dtype=_NUMPY[sub[1][0]])
     return []
 
 
-def make(msgtype: str, **values):
-    """A message of ``msgtype`` (``pkg/msg/Name``) with the given fields and every other field at its default."""
+@lru_cache(maxsize=1)
+def _nodetype():
+    """rosbags' field node types (imported on first use, as the typestore is)."""
+    from rosbags.interfaces import Nodetype
+
+    return Nodetype
+
+
+@lru_cache(maxsize=None)
+def _fields(msgtype: str) -> tuple[type, tuple, dict]:
+    """A message type's class, its (name, kind) fields, and the defaults that can be shared (numbers, strings)."""
     store = typestore()
     _, fields = store.fielddefs[msgtype]
-    args = {name: values[name] if name in values else _default(kind) for name, kind in fields}
-    return store.types[msgtype](**args)
+    shared = {name: _default(kind) for name, kind in fields if kind[0] == _nodetype().BASE}
+    return store.types[msgtype], tuple(fields), shared
+
+
+def make(msgtype: str, **values):
+    """A message of ``msgtype`` (``pkg/msg/Name``) with the given fields and every other field at its default.
+
+    Numbers and strings at their defaults are shared between messages (immutable); nested messages
+    and arrays are made afresh for each.
+    """
+    cls, fields, shared = _fields(msgtype)
+    args = {}
+    for name, kind in fields:
+        if name in values:
+            args[name] = values[name]
+        elif name in shared:
+            args[name] = shared[name]
+        else:
+            args[name] = _default(kind)
+    return cls(**args)
 
 
 def header(t_ns: int, frame: str):
