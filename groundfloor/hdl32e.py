@@ -98,22 +98,32 @@ def firing_azimuths_centideg(block_az: np.ndarray, dual) -> np.ndarray:
     dual = np.broadcast_to(np.asarray(dual, dtype=bool), block_az.shape[:1])
     az = block_az.astype(np.int64)
     diff = np.mod(az[:, -1] - az[:, 0], CENTIDEG_PER_TURN).astype(np.float32)
-    cycles_single = np.arange(BLOCKS_PER_PACKET, dtype=np.float64)
-    cycles_dual = cycles_single // 2
     out = np.empty(block_az.shape + (N_LASERS,), dtype=np.int64)
-    for is_dual, cycles in ((False, cycles_single), (True, cycles_dual)):
+    for is_dual in (False, True):
         rows = np.flatnonzero(dual == is_dual)
         if rows.size == 0:
             continue
-        duration = np.float32(CYCLE_DT_S * cycles[-1])
+        duration, dt = firing_time_offsets(is_dual)
         rate = diff[rows] / duration  # (R,) float32, 0.01 deg per s
-        # the decoder's timing table holds float32 of (cycle*46.08us + j*1.152us); dt = t[j] - t[0]
-        table = (CYCLE_DT_S * cycles[:, None] + FIRING_DT_S * np.arange(N_LASERS)[None, :]).astype(np.float32)
-        dt = (table - table[:, :1]).astype(np.float32)  # (12, 32) s since the block's first firing
         value = block_az[rows].astype(np.float32)[:, :, None] + rate[:, None, None] * dt[None, :, :]
         value = value.astype(np.float32) + np.float32(CENTIDEG_PER_TURN)
         out[rows] = np.floor(value.astype(np.float64) + 0.5).astype(np.int64) % CENTIDEG_PER_TURN  # lround (> 0)
     return out
+
+
+def firing_time_offsets(dual: bool) -> tuple[np.float32, np.ndarray]:
+    """velodyne_decoder's timing of a packet, in float32: the time from its first to its last block, s,
+    and (12, 32) each firing slot's time since its block's first firing, s.
+
+    The decoder's timing table holds float32 of (cycle * 46.08 us + j * 1.152 us); in dual-return
+    packets blocks come in pairs of one cycle.
+    """
+    cycles = np.arange(BLOCKS_PER_PACKET, dtype=np.float64)
+    if dual:
+        cycles = cycles // 2
+    duration = np.float32(CYCLE_DT_S * cycles[-1])
+    table = (CYCLE_DT_S * cycles[:, None] + FIRING_DT_S * np.arange(N_LASERS)[None, :]).astype(np.float32)
+    return duration, (table - table[:, :1]).astype(np.float32)
 
 
 def decoder_azimuths_centideg(block_az: np.ndarray, dual: bool = False) -> np.ndarray:

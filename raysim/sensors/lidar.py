@@ -29,6 +29,7 @@ from raysim.recording import nmea
 from raysim.recording.velodyne import PcapWriter, encode_data_packets, encode_position_packet
 from raysim.scene import NO_HIT, SEA_ID, intersect_sea
 from raysim.sea import FoamField
+from raysim.sensors import lidar_kernels
 from raysim.sensors import lidar_physics as phys
 from raysim.sensors.blas_threads import single_blas_thread
 from raysim.sensors.carrier import CarrierScene
@@ -192,6 +193,11 @@ class LidarRenderer(LidarGeometry):
         own-ship body-frame hits among them).
         """
         t = self.own_table
+        if jit.ENABLED:
+            free, o_free, d_free, t_free = lidar_kernels.past_own_ship(
+                firing_azimuth, t, rays.origins_m, rays.directions, rays.times_s, cand)
+            hits = self.scene.world.cast(o_free, d_free, t_free, max_range_m=self.cfg.range_max_m + CAST_RANGE_MARGIN_M)
+            return hits, free, None
         # gathers by np.take: the same values as fancy indexing, several times faster on these sizes
         key = (firing_azimuth.astype(np.int32) * hdl32e.N_LASERS + np.arange(hdl32e.N_LASERS, dtype=np.int32)).reshape(-1)
         on_own = np.take(t["hit"], key)
@@ -441,7 +447,8 @@ class LidarRenderer(LidarGeometry):
             block_az = hdl32e.block_azimuth_centideg(t, self.cfg.rotation_hz, self.cfg.azimuth0_deg)
             blocks = hdl32e.BLOCKS_PER_PACKET
             az_blocks = (np.repeat(block_az, DUAL_RETURNS) if self.dual else block_az).reshape(-1, blocks)
-            firing_az = hdl32e.decoder_azimuths_centideg(az_blocks, dual=self.dual)
+            firing_az = (lidar_kernels.decoder_azimuths(az_blocks, self.dual) if jit.ENABLED
+                         else hdl32e.decoder_azimuths_centideg(az_blocks, dual=self.dual))
             firing_az = firing_az[:, ::2] if self.dual else firing_az
             seed = self.world.scenario.seed
             self.noise_rng = chunk_stream(seed, "lidar.range_noise", index)

@@ -10,7 +10,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from groundfloor import hdl32e
 from raysim.jit import kernel
+
+TURN = hdl32e.CENTIDEG_PER_TURN
 
 
 @kernel
@@ -64,4 +67,101 @@ def world_rays(firing_az: np.ndarray, cos_el: np.ndarray, sin_el: np.ndarray, co
     return origins, directions
 
 
-__all__ = ["world_rays"]
+@kernel
+def _decoder_azimuths(block_az, duration, dt, out):
+    n_packets, n_blocks = block_az.shape
+    n_lasers = dt.shape[1]
+    for p in range(n_packets):
+        diff = (np.int64(block_az[p, n_blocks - 1]) - np.int64(block_az[p, 0])) % TURN
+        rate = np.float32(diff) / duration
+        for b in range(n_blocks):
+            start = np.float32(block_az[p, b])
+            for j in range(n_lasers):
+                value = (start + rate * dt[b, j]) + np.float32(TURN)
+                out[p, b, j] = np.uint16(np.int64(np.floor(np.float64(value) + 0.5)) % TURN)
+
+
+def decoder_azimuths(block_az: np.ndarray, dual: bool) -> np.ndarray:
+    """:func:`groundfloor.hdl32e.decoder_azimuths_centideg` in one compiled pass, the same float32 steps.
+
+    Parameters
+    ----------
+    block_az : (P, 12) uint16
+        Block azimuths of P packets, 0.01 deg.
+    dual : bool
+        Dual-return packets.
+
+    Returns
+    -------
+    (P, 12, 32) uint16
+        The azimuth of every firing slot as velodyne_decoder computes it, 0.01 deg.
+    """
+    duration, dt = hdl32e.firing_time_offsets(dual)
+    out = np.empty(block_az.shape + (dt.shape[1],), dtype=np.uint16)
+    _decoder_azimuths(np.ascontiguousarray(block_az, dtype=np.uint16), np.float32(duration), dt, out)
+    return out
+
+
+@kernel
+def _past_own_ship(key, hit, wet, table_range, table_power, table_byte, own_id, origins, directions, times,
+                   cand_range, cand_power, cand_byte, cand_id, free, free_origins, free_directions, free_times):
+    n_free = 0
+    for i in range(key.shape[0]):
+        k = key[i]
+        on_own = hit[k]
+        if on_own and wet[k]:  # the sea first? (raysim.scene.intersect_sea: -(oz / dz), kept where >= 0)
+            sea = -(origins[i, 2] / directions[i, 2])
+            if sea >= 0.0 and sea < np.float64(table_range[k]):
+                on_own = False
+        if on_own:
+            cand_range[i, 0] = table_range[k]
+            cand_power[i, 0] = table_power[k]
+            cand_byte[i, 0] = table_byte[k]
+            cand_id[i, 0] = own_id
+        else:
+            free[n_free] = i
+            for a in range(3):
+                free_origins[n_free, a] = origins[i, a]
+                free_directions[n_free, a] = directions[i, a]
+            free_times[n_free] = times[i]
+            n_free += 1
+    return n_free
+
+
+def past_own_ship(firing_az: np.ndarray, table: dict, origins_m: np.ndarray, directions: np.ndarray,
+                  times_s: np.ndarray, cand) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The own ship's echoes from its beam table into candidate column 0; the other rays gathered to be cast.
+
+    :meth:`raysim.sensors.lidar.LidarRenderer._cast_past_own_ship`'s lookups in one pass (one ray per beam).
+
+    Parameters
+    ----------
+    firing_az : (C, 32) uint16
+        Encoder step of each firing.
+    table : dict
+        The own-ship beam table (``LidarRenderer._own_ship_table``), (36000 x 32,) per beam.
+    origins_m, directions : (N, 3) float64
+        The N = 32 C rays in the world, m and unit.
+    times_s : (N,) float64
+        Each ray's time, s.
+    cand : raysim.sensors.lidar._Candidates
+        (N, E) candidates, written in column 0 where the own ship answers.
+
+    Returns
+    -------
+    free : (M,) int64
+        The rays not stopped by the own ship, in order.
+    origins_m, directions, times_s : (M, 3), (M, 3), (M,)
+        Those rays.
+    """
+    n = origins_m.shape[0]
+    key = (firing_az.astype(np.int64) * firing_az.shape[1] + np.arange(firing_az.shape[1])).reshape(-1)
+    free = np.empty(n, dtype=np.int64)
+    free_o, free_d, free_t = np.empty((n, 3)), np.empty((n, 3)), np.empty(n)
+    m = _past_own_ship(key, table["hit"], table["wet"], table["range_m"], table["power"], table["byte"],
+                       np.int32(table["object_id"]), origins_m, directions, times_s, cand.range_m, cand.power,
+                       cand.byte, cand.object_id, free, free_o, free_d, free_t)
+    return free[:m], free_o[:m], free_d[:m], free_t[:m]
+
+
+__all__ = ["decoder_azimuths", "past_own_ship", "world_rays"]

@@ -72,3 +72,50 @@ def test_render_with_kernels_is_the_numpy_render(monkeypatch):
         assert payload_k.tobytes() == payload_np.tobytes()
         hits += int((fire_k.distance_units > 0).sum())
     assert hits > 10_000  # the comparison saw real returns (own ship, ships, sea foam)
+
+
+@pytest.mark.parametrize("dual", [False, True])
+def test_decoder_azimuths_kernel_is_the_decoders_arithmetic(dual):
+    """Every firing slot's azimuth as groundfloor.hdl32e computes it (velodyne_decoder's float32 steps), on a
+    rotating head's packets (wrapping through 0) and on arbitrary block azimuths."""
+    from raysim.sensors import lidar_kernels
+
+    t = np.arange(12 * 181 * 12) * hdl32e.CYCLE_DT_S
+    blocks = hdl32e.block_azimuth_centideg(t, 10.0, 37.0)
+    if dual:
+        blocks = np.repeat(blocks, 2)[: blocks.size]
+    arbitrary = np.random.default_rng(3).integers(0, 36000, (4000, 12)).astype(np.uint16)
+    for block_az in (blocks.reshape(-1, 12), arbitrary):
+        expected = hdl32e.decoder_azimuths_centideg(block_az, dual=dual)
+        got = lidar_kernels.decoder_azimuths(block_az, dual)
+        assert got.dtype == expected.dtype == np.uint16 and np.array_equal(got, expected)
+
+
+def test_past_own_ship_kernel_sends_wet_beams_to_the_sea():
+    """A synthetic beam table: beams 0-9 on the own ship at 5 m, 0-4 of them low on the hull (wet). Rays 20 cm
+    above the sea looking down at 1/10 meet the sea at 2 m, before the hull: those wet beams go to the world,
+    as do the beams off the ship; the others are the ship's, with its range, power, byte and id."""
+    from raysim.sensors import lidar_kernels
+    from raysim.sensors.lidar import _Candidates
+
+    n_keys = 36000 * 32
+    hit = np.zeros(n_keys, bool)
+    hit[:10] = True
+    wet = np.zeros(n_keys, bool)
+    wet[:5] = True
+    table = {"hit": hit, "wet": wet, "range_m": np.full(n_keys, 5.0, np.float32),
+             "power": np.full(n_keys, 0.25, np.float32), "byte": np.full(n_keys, 40, np.uint8), "object_id": 0}
+    firing_az = np.zeros((1, 32), np.uint16)  # keys 0..31
+    origins = np.tile([0.0, 0.0, 0.2], (32, 1))
+    directions = np.tile([np.sqrt(0.99), 0.0, -0.1], (32, 1))
+    directions[2] = [1.0, 0.0, 0.0]  # a wet beam level with the sea: it never meets it, the hull answers
+    times = np.arange(32) * 1e-6
+    cand = _Candidates.empty(32, 1)
+    free, o_free, d_free, t_free = lidar_kernels.past_own_ship(firing_az, table, origins, directions, times, cand)
+    assert free.tolist() == [0, 1, 3, 4] + list(range(10, 32))
+    assert np.array_equal(o_free, origins[free]) and np.array_equal(d_free, directions[free])
+    assert np.array_equal(t_free, times[free])
+    own = [2, 5, 6, 7, 8, 9]
+    assert np.all(cand.range_m[own, 0] == 5.0) and np.all(cand.power[own, 0] == 0.25)
+    assert np.all(cand.byte[own, 0] == 40) and np.all(cand.object_id[own, 0] == 0)
+    assert np.all(np.isinf(cand.range_m[free, 0])) and np.all(cand.object_id[free, 0] == -1)
