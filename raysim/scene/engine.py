@@ -18,6 +18,8 @@ from typing import Sequence
 import numpy as np
 import open3d as o3d
 
+from raysim import jit
+from raysim.scene import kernels
 from raysim.scene.geometry import direction_cells, intersect_sea, origin_box
 from raysim.scene.hits import NO_HIT, SEA_ID, Hits, SceneObject, check_object, drop_beyond
 from raysim.scene.moving import MovingPart
@@ -169,6 +171,9 @@ class Scene:
 
     def _prepass_part(self, batch: RayBatch, near_table: np.ndarray | None, a: int, b: int) -> np.ndarray | None:
         """Fill the cells and sea ranges of rays ``a:b``; return their static candidates (or None)."""
+        if jit.ENABLED:  # one compiled pass (raysim.scene.kernels), the same values
+            return kernels.prepass(batch.origins, batch.directions, batch.max_range, near_table, batch.cells,
+                                   batch.sea_range, a, b)
         cand = []
         for s in range(a, b, CHUNK):
             e = min(b, s + CHUNK)
