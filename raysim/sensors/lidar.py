@@ -236,6 +236,10 @@ class LidarRenderer(LidarGeometry):
         (nothing comes back), foam a diffuse reflector.
         """
         o_w, d_w, times = rays.origins_m, rays.directions, rays.times_s
+        if jit.ENABLED and k == 1 and own_body is None:  # two compiled passes around the foam test, the same values
+            lidar_kernels.world_echoes(hits, free, o_w, d_w, times, self.materials, self.alpha, self.threshold,
+                                       self.foam, cand, SEA_ID, SOURCE_SEA, FOAM_REFLECTANCE)
+            return
         hit_local = np.flatnonzero(hits.object_id != NO_HIT)
         h = np.take(free, hit_local)
         r_h = np.take(hits.range_m, hit_local)

@@ -12,6 +12,7 @@ import numpy as np
 
 from groundfloor import hdl32e
 from raysim.jit import kernel
+from raysim.scene import NO_HIT as NO_HIT_ID
 
 TURN = hdl32e.CENTIDEG_PER_TURN
 
@@ -164,4 +165,98 @@ def past_own_ship(firing_az: np.ndarray, table: dict, origins_m: np.ndarray, dir
     return free[:m], free_o[:m], free_d[:m], free_t[:m]
 
 
-__all__ = ["decoder_azimuths", "past_own_ship", "world_rays"]
+@kernel
+def _echo_geometry(hit_rows, free, ranges, normals, materials, object_ids, origins, directions, times,
+                   reflectance_table, sea_id, foam_reflectance, attenuation, threshold,
+                   cos_out, reflectance_out, foam_rows, foam_x, foam_y, foam_t):
+    n_foam = 0
+    for j in range(hit_rows.shape[0]):
+        row = hit_rows[j]
+        h = free[row]
+        r = ranges[row]
+        # numpy's einsum("ij,ij->i") sums a row of 3 as (x + z) + y: the same order gives the same bits
+        cos = abs((np.float64(normals[row, 0]) * directions[h, 0] + np.float64(normals[row, 2]) * directions[h, 2])
+                  + np.float64(normals[row, 1]) * directions[h, 1])
+        cos_out[j] = cos
+        if object_ids[row] == sea_id:  # calm water: a mirror; foam where a foam echo could be detected at all
+            reflectance_out[j] = 0.0
+            if ((foam_reflectance * cos) * attenuation[j]) / (r * r) >= threshold:
+                foam_rows[n_foam] = j
+                foam_x[n_foam] = origins[h, 0] + r * directions[h, 0]
+                foam_y[n_foam] = origins[h, 1] + r * directions[h, 1]
+                foam_t[n_foam] = times[h]
+                n_foam += 1
+        else:
+            reflectance_out[j] = np.float64(reflectance_table[materials[row]])
+    return n_foam
+
+
+@kernel
+def _echo_values(hit_rows, free, ranges, materials, object_ids, sea_id, cos_h, reflectance, attenuation, retro_table,
+                 source_sea, cand_range, cand_power, cand_byte, cand_id, cand_source):
+    for j in range(hit_rows.shape[0]):
+        row = hit_rows[j]
+        h = free[row]
+        r = ranges[row]
+        cos = cos_h[j]
+        rho = reflectance[j]
+        cand_range[h, 0] = r
+        cand_power[h, 0] = ((rho * cos) * attenuation[j]) / (r * r)
+        if retro_table[materials[row]]:
+            cand_byte[h, 0] = np.uint8(101.0 + np.rint(154.0 * min(max(cos, 0.0), 1.0)))
+        else:
+            cand_byte[h, 0] = np.uint8(min(max(np.rint((100.0 * rho) * cos), 1.0), 100.0))
+        sea = object_ids[row] == sea_id
+        cand_id[h, 0] = -1 if sea else object_ids[row]
+        cand_source[h, 0] = source_sea if sea else 0
+
+
+def world_echoes(hits, free: np.ndarray, origins_m: np.ndarray, directions: np.ndarray, times_s: np.ndarray,
+                 materials: dict, alpha_per_m: float, threshold: float, foam, cand, sea_id: int, source_sea: int,
+                 foam_reflectance: float) -> None:
+    """The world's echoes of one ray per beam into candidate column 0 (``LidarRenderer._world_echoes``, K = 1).
+
+    Two compiled passes around the foam field's test (numpy, :meth:`raysim.sea.FoamField.is_foam`): the
+    incidence cosine, reflectance and the sea hits that could show foam; then each echo's range, power
+    ``rho cos exp(-2 alpha R) / R^2``, reflectivity byte, id and source. The atmosphere's
+    ``exp(-2 alpha R)`` is numpy's (1 without fog or rain), so the powers are the numpy path's.
+
+    Parameters
+    ----------
+    hits : raysim.scene.Hits
+        The world's first hits of the M rays cast.
+    free : (M,) int64
+        The chunk's ray index of each ray cast.
+    origins_m, directions : (N, 3) float64; times_s : (N,) float64
+        The chunk's rays.
+    materials : dict
+        :func:`raysim.materials.material_table`.
+    alpha_per_m, threshold : float
+        Extinction, 1/m, and the detection threshold (relative power).
+    foam : raysim.sea.FoamField
+    cand : raysim.sensors.lidar._Candidates
+        (N, E) candidates, column 0 written at the rays that hit something.
+    sea_id, source_sea : int
+        The sea's hit id and the sea's return source.
+    foam_reflectance : float
+        Foam's diffuse reflectance at 905 nm.
+    """
+    hit_rows = np.flatnonzero(hits.object_id != NO_HIT_ID)
+    m = hit_rows.size
+    ranges = hits.range_m
+    attenuation = (np.exp(-2.0 * alpha_per_m * np.take(ranges, hit_rows)) if alpha_per_m > 0 else np.ones(m))
+    cos_h, reflectance = np.empty(m), np.empty(m)
+    foam_rows, foam_x, foam_y, foam_t = np.empty(m, np.int64), np.empty(m), np.empty(m), np.empty(m)
+    normals = np.ascontiguousarray(hits.normal)
+    n_foam = _echo_geometry(hit_rows, free, ranges, normals, hits.material, hits.object_id, origins_m, directions,
+                            times_s, materials["reflectance_905nm"], sea_id, foam_reflectance, attenuation, threshold,
+                            cos_h, reflectance, foam_rows, foam_x, foam_y, foam_t)
+    if n_foam:
+        is_foam = foam.is_foam(foam_x[:n_foam], foam_y[:n_foam], foam_t[:n_foam])
+        reflectance[foam_rows[:n_foam][is_foam]] = foam_reflectance
+    _echo_values(hit_rows, free, ranges, hits.material, hits.object_id, sea_id, cos_h, reflectance, attenuation,
+                 materials["retroreflective"], source_sea, cand.range_m, cand.power, cand.byte, cand.object_id,
+                 cand.source)
+
+
+__all__ = ["decoder_azimuths", "past_own_ship", "world_echoes", "world_rays"]

@@ -119,3 +119,44 @@ def test_past_own_ship_kernel_sends_wet_beams_to_the_sea():
     assert np.all(cand.range_m[own, 0] == 5.0) and np.all(cand.power[own, 0] == 0.25)
     assert np.all(cand.byte[own, 0] == 40) and np.all(cand.object_id[own, 0] == 0)
     assert np.all(np.isinf(cand.range_m[free, 0])) and np.all(cand.object_id[free, 0] == -1)
+
+
+@pytest.mark.parametrize("alpha_per_m", [0.0, 0.004])
+def test_world_echoes_kernel_is_the_numpy_path(renderer, monkeypatch, alpha_per_m):
+    """Synthetic hits of every kind (none, the sea near and far with and without foam, a retro-reflector, grazing
+    and head-on hulls) through LidarRenderer._world_echoes with the kernels and without: the same candidates."""
+    from raysim.scene import NO_HIT, SEA_ID, Hits
+    from raysim.sensors.lidar import _Candidates, _Rays
+
+    rng = np.random.default_rng(11)
+    n = 4000
+    d = rng.normal(size=(n, 3))
+    d[:, 2] = -np.abs(d[:, 2]) * 0.3
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    o = np.column_stack([rng.uniform(-20, 20, n), rng.uniform(-20, 20, n), np.full(n, 3.0)])
+    t = np.sort(rng.uniform(0.0, 0.1, n))
+    free = np.sort(rng.choice(n, 3000, replace=False))
+    m = free.size
+    kind = rng.integers(0, 4, m)  # no hit, sea, hull, retro-reflector
+    object_id = np.where(kind == 0, NO_HIT, np.where(kind == 1, SEA_ID, 5)).astype(np.int32)
+    material = np.where(kind == 3, 9, np.where(kind == 1, renderer.sea_material, 2)).astype(np.int16)
+    normal = rng.normal(size=(m, 3)).astype(np.float32)
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+    normal[kind == 1] = [0.0, 0.0, 1.0]
+    range_m = np.where(kind == 0, np.inf, rng.uniform(1.0, 110.0, m))
+    hits = Hits(range_m, object_id, normal, material, np.zeros(m, np.int32))
+    rays = _Rays(o, d, t)
+    monkeypatch.setattr(renderer, "alpha", alpha_per_m)
+    monkeypatch.setattr(renderer.foam, "coverage", 0.3)  # plenty of foam to test
+    results = []
+    for enabled in (True, False):
+        monkeypatch.setattr(jit, "ENABLED", enabled)
+        cand = _Candidates.empty(n, 1)
+        renderer._world_echoes(cand, rays, hits, free, None, 1)
+        results.append(cand)
+    compiled, numpy_path = results
+    for name in ("range_m", "power", "byte", "object_id", "source"):
+        assert np.array_equal(getattr(compiled, name), getattr(numpy_path, name)), name
+    assert (compiled.byte > 100).any() and (compiled.source == 1).any()  # retro-reflector and sea seen
+    if alpha_per_m == 0:  # in clear air some of the sea is foam (in this fog, too faint to be seen)
+        assert len(np.unique(compiled.byte[compiled.source == 1])) > 1
