@@ -296,6 +296,10 @@ class LidarRenderer(LidarGeometry):
         Echoes are grouped and picked by the return mode (R = 2 in dual mode), range noise added,
         the range quantised to 2 mm units and kept within the sensor's range.
         """
+        if jit.ENABLED and cand.range_m.shape[1] == 1 and not self.dual:  # one candidate: strongest = last
+            return lidar_kernels.single_returns(cand, self.threshold, self.noise_rng, self.cfg.range_noise_m,
+                                                hdl32e.DISTANCE_UNIT_M, self.cfg.range_min_m, self.cfg.range_max_m,
+                                                MAX_DISTANCE_UNITS)
         echoes = phys.select_echoes(cand.range_m, cand.power, self.threshold)
         strongest, last, group_r, group_id = echoes.strongest, echoes.last, echoes.group_range, echoes.group
         picks = [last, phys.dual_pick(echoes)] if self.dual else [last if self.cfg.return_mode == "last" else strongest]

@@ -259,4 +259,52 @@ def world_echoes(hits, free: np.ndarray, origins_m: np.ndarray, directions: np.n
                  cand.source)
 
 
-__all__ = ["decoder_azimuths", "past_own_ship", "world_echoes", "world_rays"]
+@kernel
+def _detected(range_m, power, threshold, rows):
+    n = 0
+    for i in range(range_m.shape[0]):
+        if np.isfinite(range_m[i, 0]) and power[i, 0] >= threshold:
+            rows[n] = i
+            n += 1
+    return n
+
+
+@kernel
+def _quantised(rows, range_m, noise_m, unit_m, range_min_m, range_max_m, max_units, byte, object_id, source,
+               units_out, byte_out, id_out, source_out):
+    for i in range(rows.shape[0]):
+        row = rows[i]
+        measured = range_m[row, 0] + noise_m[i]
+        q = np.rint(measured / unit_m)
+        if measured >= range_min_m and measured <= range_max_m and q >= 1 and q <= max_units:
+            units_out[row] = np.uint16(q)
+            byte_out[row] = byte[row, 0]
+            id_out[row] = object_id[row, 0]
+            source_out[row] = source[row, 0]
+
+
+def single_returns(cand, threshold: float, noise_rng, noise_m: float, unit_m: float, range_min_m: float,
+                   range_max_m: float, max_units: int):
+    """``LidarRenderer._returns`` for one candidate per firing (one ray per beam, clear air), one return each.
+
+    A firing returns its candidate when it is detected (finite range, power at the threshold or
+    above); its range gets the range noise (numpy's draws, one per return in firing order, as the
+    numpy path draws them) and is quantised to the packets' units, kept within the sensor's range.
+
+    Returns
+    -------
+    units, byte, object_id, source : (1, F)
+        uint16 distance units (0: no return), uint8 reflectivity, int32 ids (-1: none), uint8 sources.
+    """
+    f = cand.range_m.shape[0]
+    rows = np.empty(f, dtype=np.int64)
+    rows = rows[:_detected(cand.range_m, cand.power, threshold, rows)]
+    noise = noise_rng.normal(0.0, noise_m, rows.size) if noise_m > 0 else np.zeros(rows.size)
+    units, byte = np.zeros((1, f), dtype=np.uint16), np.zeros((1, f), dtype=np.uint8)
+    object_id, source = np.full((1, f), -1, dtype=np.int32), np.zeros((1, f), dtype=np.uint8)
+    _quantised(rows, cand.range_m, noise, unit_m, range_min_m, range_max_m, max_units, cand.byte, cand.object_id,
+               cand.source, units[0], byte[0], object_id[0], source[0])
+    return units, byte, object_id, source
+
+
+__all__ = ["decoder_azimuths", "past_own_ship", "single_returns", "world_echoes", "world_rays"]

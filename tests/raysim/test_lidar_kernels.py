@@ -160,3 +160,33 @@ def test_world_echoes_kernel_is_the_numpy_path(renderer, monkeypatch, alpha_per_
     assert (compiled.byte > 100).any() and (compiled.source == 1).any()  # retro-reflector and sea seen
     if alpha_per_m == 0:  # in clear air some of the sea is foam (in this fog, too faint to be seen)
         assert len(np.unique(compiled.byte[compiled.source == 1])) > 1
+
+
+def test_single_returns_kernel_is_the_numpy_path(renderer, monkeypatch):
+    """Candidates of every kind (none, too weak, too near, too far, in range), noise from equal generators:
+    LidarRenderer._returns gives the same distance units, bytes, ids and sources with the kernel and without."""
+    from raysim.random_streams import stream
+    from raysim.sensors.lidar import _Candidates
+
+    rng = np.random.default_rng(4)
+    f = 5000
+    cand = _Candidates.empty(f, 1)
+    kind = rng.integers(0, 5, f)
+    cand.range_m[:, 0] = np.where(kind == 0, np.inf, np.where(kind == 2, 0.01, np.where(kind == 3, 100.005,
+                                                                                           rng.uniform(0.5, 99.0, f))))
+    cand.power[:, 0] = np.where(kind == 1, renderer.threshold * 0.5, renderer.threshold * rng.uniform(1.0, 50.0, f))
+    cand.power[np.flatnonzero(kind == 4)[:20], 0] = renderer.threshold  # exactly at the threshold: detected
+    cand.byte[:, 0] = rng.integers(1, 255, f)
+    cand.object_id[:, 0] = rng.integers(-1, 9, f)
+    cand.source[:, 0] = rng.integers(0, 3, f)
+    results = []
+    for enabled in (True, False):
+        monkeypatch.setattr(jit, "ENABLED", enabled)
+        monkeypatch.setattr(renderer, "noise_rng", stream(7, "test.noise"))
+        results.append(renderer._returns(cand, f))
+    for compiled, numpy_path in zip(*results):
+        assert compiled.shape == numpy_path.shape == (1, f) and compiled.dtype == numpy_path.dtype
+        assert np.array_equal(compiled, numpy_path)
+    units = results[0][0][0]
+    assert (units > 0).sum() > f // 5 and (units[kind == 0] == 0).all() and (units[kind == 1] == 0).all()
+    assert (units[np.flatnonzero(kind == 4)[:20]] > 0).all()
