@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import io
 import re
-import struct
 import zipfile
 from pathlib import Path
 from typing import Mapping, Sequence
@@ -23,6 +22,7 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from groundfloor.recording import SweepSchema, sweep_file_name
+from groundfloor.zip_stored import stored_members
 from raysim.recording.staging import atomic_path
 
 _EPOCH = (1980, 1, 1, 0, 0, 0)
@@ -89,7 +89,6 @@ def write_sweep_pieces(sweeps_dir: Path, number: int, schema: SweepSchema,
     write_npz_pieces(Path(sweeps_dir) / sweep_file_name(number), pieces)
 
 
-_LOCAL_HEADER = struct.Struct("<4sHHHHHIIIHH")  # ZIP local file header (APPNOTE 4.3.7), 30 bytes
 _NPY_HEADER = re.compile(rb"\{'descr': '([<>|][a-zA-Z]\d+)', 'fortran_order': False, 'shape': \(([\d, ]*)\), \}")
 _NPY_MAGIC = b"\x93NUMPY\x01\x00"
 
@@ -98,10 +97,11 @@ def read_npz(path: Path) -> dict[str, np.ndarray]:
     """Every array of an .npz file, read in one pass: views on the file's bytes, no copies.
 
     The files this module writes (stored members, ``.npy`` format 1.0, C order) are parsed here
-    directly: ``np.load`` spends most of a small sweep's read on the zip directory, a CRC of every
-    member and a Python parse of every header. Any other file (compressed, another writer's, a
-    format this parser does not know) is read with ``np.load``, as are the files whose members do
-    not check out. For files this run wrote (the bag, the pictures); the TDM's readers check more.
+    directly (the zip directory by :func:`groundfloor.zip_stored.stored_members`, which the TDM's
+    reader uses too): ``np.load`` spends most of a small sweep's read on zipfile's machinery, a CRC of
+    every member and a Python parse of every header. Any other file (compressed, another writer's, a
+    header this parser does not know) is read with ``np.load``. For files this run wrote (the bag, the
+    pictures): the CRCs are not checked; the TDM's reader checks them.
     """
     data = Path(path).read_bytes()
     arrays = _parse_stored(data)
@@ -113,20 +113,16 @@ def read_npz(path: Path) -> dict[str, np.ndarray]:
 
 def _parse_stored(data: bytes) -> dict[str, np.ndarray] | None:
     """The members of a stored .npz image as arrays, or None where anything is not as this writer writes it."""
+    members = stored_members(data)
+    if not members:
+        return None
     arrays: dict[str, np.ndarray] = {}
-    at, size = 0, len(data)
-    while at + _LOCAL_HEADER.size <= size and data[at:at + 4] == b"PK\x03\x04":
-        _, _, flags, method, _, _, _, csize, usize, name_len, extra_len = _LOCAL_HEADER.unpack_from(data, at)
-        start = at + _LOCAL_HEADER.size + name_len + extra_len
-        name = data[at + _LOCAL_HEADER.size:at + _LOCAL_HEADER.size + name_len].decode("utf-8", "replace")
-        if method != 0 or flags & 0x08 or csize != usize or start + csize > size or not name.endswith(".npy"):
-            return None
-        array = _parse_npy(data, start, csize)
+    for member in members:
+        array = _parse_npy(data, member.data_start, member.file_size) if member.filename.endswith(".npy") else None
         if array is None:
             return None
-        arrays[name[:-4]] = array
-        at = start + csize
-    return arrays if arrays and data[at:at + 4] == b"PK\x01\x02" else None
+        arrays[member.filename[:-4]] = array
+    return arrays
 
 
 def _parse_npy(data: bytes, start: int, length: int) -> np.ndarray | None:

@@ -10,7 +10,7 @@
 
 A file of up to :data:`IN_MEMORY_MAX_BYTES` is read in one system call. When it is a plain archive of
 stored (uncompressed) members, which is how ``np.savez`` and raysim write sweeps, its directory is read
-from those bytes (:mod:`tdm.recording.zip_stored`) and each member's data sliced out of them, its
+from those bytes (:mod:`groundfloor.zip_stored`) and each member's data sliced out of them, its
 CRC-32 checked as ``zipfile`` checks it; any other archive (compressed, damaged, larger) is read by
 ``zipfile``, which also says what is wrong with a damaged one. Each ``.npy`` header is read by a fast
 parser of numpy's own header text (anything else goes to numpy's parser). Both routes give the same
@@ -39,7 +39,7 @@ import numpy as np
 
 from tdm.errors import RecordingError
 from tdm.recording.files import regular_file
-from tdm.recording.zip_stored import StoredMember, stored_members
+from groundfloor.zip_stored import StoredMember, stored_members
 
 __all__ = ["ArrayHeader", "NpzFile", "Unreadable", "read_layout", "load_arrays", "MAX_ARRAY_BYTES",
            "IN_MEMORY_MAX_BYTES"]
@@ -110,7 +110,7 @@ class ArrayHeader:
 def _open_zip(path: Path) -> tuple[zipfile.ZipFile | None, bytes | None, list[StoredMember] | None]:
     """The archive: a :class:`zipfile.ZipFile` (None when the members were found without it), the file's
     bytes when it is small enough to be read whole (else None), and its stored members when it is a
-    plain archive of them (:func:`tdm.recording.zip_stored.stored_members`; else None)."""
+    plain archive of them (:func:`groundfloor.zip_stored.stored_members`; else None)."""
     regular_file(path)
     size = os.stat(path).st_size
     if size == 0:

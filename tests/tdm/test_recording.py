@@ -181,7 +181,7 @@ def test_numbers_are_finite_and_bounded():
 
 
 def test_a_plain_stored_archives_directory_is_read_as_zipfile_reads_it(tmp_path):
-    from tdm.recording.zip_stored import stored_members
+    from groundfloor.zip_stored import stored_members
 
     np.savez(tmp_path / "a.npz", x=np.arange(10.0), ring=np.arange(4, dtype=np.uint8), empty=np.zeros(0))
     data = (tmp_path / "a.npz").read_bytes()
