@@ -130,6 +130,11 @@ def _fields(msgtype: str) -> tuple[type, tuple, dict]:
     return store.types[msgtype], tuple(fields), shared
 
 
+def message_class(msgtype: str) -> type:
+    """The class of ``msgtype`` (``pkg/msg/Name``), to build many small messages whose every field is given."""
+    return _fields(msgtype)[0]
+
+
 def make(msgtype: str, **values):
     """A message of ``msgtype`` (``pkg/msg/Name``) with the given fields and every other field at its default.
 

@@ -17,7 +17,8 @@ from groundfloor.frames import mount_transform
 from groundfloor.recording import AIS_NMEA, LIDAR_SWEEPS, RADAR_SWEEPS
 from raysim.recording.npz import read_npz
 from raysim.recording.pointclouds import PCD_DTYPE, velodyne_points
-from raysim.recording.rosbag.msgs import BagMessage, duration, header, make, point, quaternion, quaternion_from_matrix
+from raysim.recording.rosbag.msgs import (BagMessage, duration, header, make, message_class, point, quaternion,
+                                          quaternion_from_matrix)
 
 __all__ = ["static_transforms", "lidar_clouds", "radar_sectors", "ais_sentences", "POINT_STEP"]
 
@@ -65,6 +66,7 @@ def radar_sectors(recording: Path, ns_of: NsOf) -> Iterator[BagMessage]:
     Both stamped at spoke 0 of the revolution; the picture is ``radar/ppi/NNNNNN.png`` as written.
     """
     ppi_dir = recording / "radar" / "ppi"
+    radar_echo = message_class("marine_sensor_msgs/msg/RadarEcho")  # its one field given: built directly, 2048 a sweep
     for path in sorted((recording / RADAR_SWEEPS).glob("*.npz")):
         sweep = read_npz(path)
         echo, az, times, rng = sweep["echo"], sweep["azimuth_deg"], sweep["time"], sweep["range_m"]
@@ -76,7 +78,7 @@ def radar_sectors(recording: Path, ns_of: NsOf) -> Iterator[BagMessage]:
                    angle_start=float(-math.radians(az[0])), angle_increment=float(-2.0 * math.pi / spokes),
                    time_increment=duration(dt), scan_time=duration(dt * spokes), range_min=float(rng[0]),
                    range_max=float(rng[-1]),
-                   intensities=[make("marine_sensor_msgs/msg/RadarEcho", echoes=row) for row in echoes])
+                   intensities=[radar_echo(echoes=row) for row in echoes])
         yield BagMessage(t_ns, "/radar/sector", "marine_sensor_msgs/msg/RadarSector", msg)
         picture = ppi_dir / f"{path.stem}.png"
         if picture.is_file():
