@@ -340,6 +340,9 @@ class LidarRenderer(LidarGeometry):
         Geometry exactly as a decoder reconstructs it from the packets:
         ``x = d cos w cos a, y = -d cos w sin a, z = d sin w + z_offset``.
         """
+        if jit.ENABLED and not self.dual:  # one return a firing: one compiled pass, the same values
+            return lidar_kernels.points(fire.distance_units, fire.reflectivity, fire.object_id, fire.source,
+                                        fire.firing_azimuth, fire.cycle_time_s)
         units = fire.distance_units  # (C, R, 32)
         keep = units > 0
         if self.dual:  # a repeated echo (same distance in both blocks) is one point, as decoders report it

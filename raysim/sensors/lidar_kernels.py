@@ -15,6 +15,8 @@ from raysim.jit import kernel
 from raysim.scene import NO_HIT as NO_HIT_ID
 
 TURN = hdl32e.CENTIDEG_PER_TURN
+#: Encoder steps (0.01 deg) to degrees.
+DEG_PER_STEP = 0.01
 
 
 @kernel
@@ -307,4 +309,76 @@ def single_returns(cand, threshold: float, noise_rng, noise_m: float, unit_m: fl
     return units, byte, object_id, source
 
 
-__all__ = ["decoder_azimuths", "past_own_ship", "single_returns", "world_echoes", "world_rays"]
+@kernel
+def _count_returns(units):
+    n = 0
+    for c in range(units.shape[0]):
+        for j in range(units.shape[2]):
+            if units[c, 0, j] > 0:
+                n += 1
+    return n
+
+
+@kernel
+def _points(units, reflectivity, object_ids, sources, firing_az, cycle_time_s, cos_el, sin_el, z_offset_m, cos_az,
+            sin_az, ring, unit_m, firing_dt_s, deg_per_step, x, y, z, intensity, ring_out, time, azimuth_deg, ids,
+            source_out, cycle_out):
+    n_cycles, n_lasers = firing_az.shape
+    k = 0
+    for c in range(n_cycles):
+        for j in range(n_lasers):
+            u = units[c, 0, j]
+            if u == 0:
+                continue
+            d = np.float64(u) * unit_m
+            a = firing_az[c, j]
+            xy = d * cos_el[j]
+            x[k] = np.float32(xy * cos_az[a])
+            y[k] = np.float32(-xy * sin_az[a])
+            z[k] = np.float32(d * sin_el[j] + z_offset_m[j])
+            intensity[k] = reflectivity[c, 0, j]
+            ring_out[k] = ring[j]
+            time[k] = cycle_time_s[c] + np.float64(j) * firing_dt_s
+            azimuth_deg[k] = np.float32(np.float64(a) * deg_per_step)
+            ids[k] = object_ids[c, 0, j]
+            source_out[k] = sources[c, 0, j]
+            cycle_out[k] = c
+            k += 1
+
+
+def points(distance_units: np.ndarray, reflectivity: np.ndarray, object_id: np.ndarray, source: np.ndarray,
+           firing_az: np.ndarray, cycle_time_s: np.ndarray) -> tuple[dict[str, np.ndarray], np.ndarray]:
+    """``LidarRenderer.points`` of single-return firings in one pass: the sweep arrays and each point's cycle.
+
+    Parameters
+    ----------
+    distance_units, reflectivity, object_id, source : (C, 1, 32)
+        The chunk's returns (uint16 units of 2 mm, 0: none; uint8; int32; uint8).
+    firing_az : (C, 32) uint16
+        Encoder step of each firing.
+    cycle_time_s : (C,) float64
+        Start of each cycle, s.
+
+    Returns
+    -------
+    arrays : dict of (N,) arrays
+        The NPZ contract's x, y, z (float32, m), intensity, ring, time (s), azimuth_deg, object_id,
+        return_source, return_index, in firing order.
+    cycle : (N,) int64
+        Each point's cycle.
+    """
+    n = _count_returns(distance_units)
+    x, y, z = np.empty(n, np.float32), np.empty(n, np.float32), np.empty(n, np.float32)
+    intensity, ring, time = np.empty(n, np.uint8), np.empty(n, np.uint8), np.empty(n)
+    azimuth_deg, ids, source_out = np.empty(n, np.float32), np.empty(n, np.int32), np.empty(n, np.uint8)
+    cycle = np.empty(n, np.int64)
+    _points(distance_units, reflectivity, object_id, source, np.ascontiguousarray(firing_az), cycle_time_s,
+            hdl32e.COS_ELEVATION, hdl32e.SIN_ELEVATION, hdl32e.Z_OFFSET_M, hdl32e.COS_AZIMUTH_STEP,
+            hdl32e.SIN_AZIMUTH_STEP, hdl32e.RING, hdl32e.DISTANCE_UNIT_M, hdl32e.FIRING_DT_S, DEG_PER_STEP,
+            x, y, z, intensity, ring, time, azimuth_deg, ids, source_out, cycle)
+    arrays = {"x": x, "y": y, "z": z, "intensity": intensity, "ring": ring, "time": time, "azimuth_deg": azimuth_deg,
+              "object_id": ids, "return_source": source_out, "return_index": np.zeros(n, np.uint8)}
+    return arrays, cycle
+
+
+__all__ = ["decoder_azimuths", "past_own_ship", "points", "single_returns", "world_echoes", "world_rays"]

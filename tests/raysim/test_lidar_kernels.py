@@ -190,3 +190,20 @@ def test_single_returns_kernel_is_the_numpy_path(renderer, monkeypatch):
     units = results[0][0][0]
     assert (units > 0).sum() > f // 5 and (units[kind == 0] == 0).all() and (units[kind == 1] == 0).all()
     assert (units[np.flatnonzero(kind == 4)[:20]] > 0).all()
+
+
+def test_points_kernel_is_the_numpy_path(monkeypatch):
+    """A rendered chunk's sweep arrays (every field, dtype and order) and point cycles, with the kernel and without."""
+    world = World(busy_open_sea(0.2))
+    lidar = LidarRenderer(world, CarrierScene(world.scene_objects(), sea_material=material_index("sea")))
+    fire = next(lidar.chunks()).firings
+    results = []
+    for enabled in (True, False):
+        monkeypatch.setattr(jit, "ENABLED", enabled)
+        results.append(lidar.points(fire))
+    (arrays_k, cycle_k), (arrays_np, cycle_np) = results
+    assert list(arrays_k) == list(arrays_np) and np.array_equal(cycle_k, cycle_np)
+    for name in arrays_np:
+        assert arrays_k[name].dtype == arrays_np[name].dtype, name
+        assert np.array_equal(arrays_k[name], arrays_np[name]), name
+    assert arrays_np["x"].size > 5000
