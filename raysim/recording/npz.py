@@ -14,7 +14,6 @@ one ``numpy.lib.format.write_array`` and ``ZipFile.writestr`` would give
 from __future__ import annotations
 
 import io
-import re
 import zipfile
 from pathlib import Path
 from typing import Mapping, Sequence
@@ -22,6 +21,7 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from groundfloor.recording import SweepSchema, sweep_file_name
+from groundfloor.npy_header import NPY_PREFIX_BYTES, numpy_header_text
 from groundfloor.zip_stored import stored_members
 from raysim.recording.staging import atomic_path
 
@@ -89,7 +89,6 @@ def write_sweep_pieces(sweeps_dir: Path, number: int, schema: SweepSchema,
     write_npz_pieces(Path(sweeps_dir) / sweep_file_name(number), pieces)
 
 
-_NPY_HEADER = re.compile(rb"\{'descr': '([<>|][a-zA-Z]\d+)', 'fortran_order': False, 'shape': \(([\d, ]*)\), \}")
 _NPY_MAGIC = b"\x93NUMPY\x01\x00"
 
 
@@ -129,14 +128,12 @@ def _parse_npy(data: bytes, start: int, length: int) -> np.ndarray | None:
     """An ``.npy`` format 1.0 image at ``data[start:start + length]`` as a read-only view, or None."""
     if data[start:start + 8] != _NPY_MAGIC:
         return None
-    header_len = int.from_bytes(data[start + 8:start + 10], "little")
-    match = _NPY_HEADER.match(data, start + 10, start + 10 + header_len)
-    if match is None:
+    offset = start + NPY_PREFIX_BYTES + int.from_bytes(data[start + 8:start + NPY_PREFIX_BYTES], "little")
+    decoded = numpy_header_text(data, start + NPY_PREFIX_BYTES, offset)
+    if decoded is None or decoded[1]:  # another text, or Fortran order: np.load's
         return None
-    dtype = np.dtype(match.group(1).decode("ascii"))
-    shape = tuple(int(v) for v in match.group(2).split(b",") if v.strip())
+    shape, _, dtype = decoded
     count = int(np.prod(shape, dtype=np.int64))
-    offset = start + 10 + header_len
     if offset + count * dtype.itemsize != start + length:
         return None
     return np.frombuffer(data, dtype=dtype, count=count, offset=offset).reshape(shape)

@@ -444,7 +444,7 @@ class LidarRenderer(LidarGeometry):
             The chunk's firings, data packets and their send times, and the position packets due in it.
         """
         chunk_packets = self.chunk_packets
-        next_position_s = self._positions_before(first)
+        next_position_s = self._positions_before(first)[0]
         indices = range(first, self.n_chunks if end is None else min(end, self.n_chunks))
         for index in (progress(indices) if progress else indices):
             if claim is not None and not claim(index):
@@ -477,16 +477,18 @@ class LidarRenderer(LidarGeometry):
             yield LidarChunk(t, fire, payloads, sent, position_times)
             self.chunk_wall_s.append((t_end - t[0], time.perf_counter() - chunk_started))
 
-    def _positions_before(self, first: int) -> float:
-        """The time of the first position packet of chunk ``first``, s, summed as the chunks before it sum it."""
-        next_position_s = 0.0
+    def _positions_before(self, first: int) -> tuple[float, int]:
+        """The time of the first position packet of chunk ``first``, s (summed as the chunks before it sum
+        it), and how many position packets the chunks before it hold."""
+        next_position_s, count = 0.0, 0
         if first == 0 or self.cfg.position_packet_rate_hz <= 0:
-            return next_position_s
+            return next_position_s, count
         # the end of chunk first - 1 exactly as chunks() computes it: its last cycle's start plus a cycle
         t_end = (first * self.chunk_packets * self.cycles_per_packet - 1) * hdl32e.CYCLE_DT_S + hdl32e.CYCLE_DT_S
         while next_position_s < t_end:
             next_position_s += 1.0 / self.cfg.position_packet_rate_hz
-        return next_position_s
+            count += 1
+        return next_position_s, count
 
     def run(self, out_dir: Path, progress=None) -> dict:
         """Render the whole scenario into ``out_dir/lidar``; returns counts for the manifest."""

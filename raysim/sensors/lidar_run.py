@@ -41,12 +41,11 @@ def render_chunks(renderer, out_dir: Path, progress=None, first: int = 0, end: i
 
     lidar_dir = out_dir / "lidar"
     start_s = renderer.chunk_start_s(first)
-    sweeps = LidarSweeps(renderer, lidar_dir / "sweeps")
-    if first > 0:  # from the revolution under way at the first chunk: its first points are in the chunk before
-        sweeps = LidarSweeps(renderer, lidar_dir / "sweeps", first_revolution=sweeps.revolution_at(start_s))
+    # from the revolution under way at the first chunk: its first points are in the chunk before
+    sweeps = LidarSweeps(renderer, lidar_dir / "sweeps", from_s=start_s)
     counts = {"packets": 0, "position_packets": 0}
     path = lidar_dir / (PCAP_NAME if first == 0 else f"{PART_PREFIX}{first:06d}")
-    frames_before = first * renderer.chunk_packets + _position_count_before(renderer, first)
+    frames_before = first * renderer.chunk_packets + renderer._positions_before(first)[1]
     last = first
     with atomic_path(path) as tmp, open(tmp, "wb") as handle:
         pcap = PcapWriter(handle, header=first == 0, frames_before=frames_before)
@@ -60,14 +59,6 @@ def render_chunks(renderer, out_dir: Path, progress=None, first: int = 0, end: i
             last += 1
         sweeps.finish(renderer.chunk_start_s(last))
     return {**counts, **sweeps.counts}
-
-
-def _position_count_before(renderer, first: int) -> int:
-    """Position packets the chunks before ``first`` hold."""
-    rate = renderer.cfg.position_packet_rate_hz
-    if first == 0 or rate <= 0:
-        return 0
-    return int(round(renderer._positions_before(first) * rate))
 
 
 def join_pcap_parts(lidar_dir: Path) -> None:

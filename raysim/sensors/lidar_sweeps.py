@@ -10,7 +10,6 @@ from pathlib import Path
 
 import numpy as np
 
-from groundfloor import hdl32e
 from groundfloor.recording import LIDAR_SWEEP
 from raysim.recording.npz import write_sweep_pieces
 
@@ -27,22 +26,18 @@ class LidarSweeps:
     renderer : raysim.sensors.lidar.LidarRenderer
     sweeps_dir : Path
         Where ``NNNNNN.npz`` go (created).
-    first_revolution : int
-        Revolutions before this one are not written (a later part of a run: their points are
-        another part's).
+    from_s : float
+        Revolutions that began before the one under way at this time, s, are not written (a later
+        part of a run: their points are another part's).
     """
 
-    def __init__(self, renderer, sweeps_dir: Path, first_revolution: int = 0):
+    def __init__(self, renderer, sweeps_dir: Path, from_s: float = 0.0):
         self.renderer = renderer
         self.sweeps_dir = Path(sweeps_dir)
         self.sweeps_dir.mkdir(parents=True, exist_ok=True)
         self.pending: list[dict] = []
-        self.first_revolution = self.current = int(first_revolution)
+        self.first_revolution = self.current = int(self._revolution(np.array([from_s]))[0]) if from_s > 0 else 0
         self.counts = {"sweeps": 0, "points": 0}
-
-    def revolution_at(self, t_s: float) -> int:
-        """The revolution under way at time ``t_s``, s."""
-        return int(self._revolution(np.array([t_s]))[0])
 
     def _revolution(self, t_s: np.ndarray) -> np.ndarray:
         cfg = self.renderer.cfg
@@ -70,7 +65,7 @@ class LidarSweeps:
     def finish(self, end_s: float | None = None) -> None:
         """Write the last revolution if the render completed it (before ``end_s``: by default the run's end)."""
         r = self.renderer
-        end_s = r.n_packets * r.cycles_per_packet * hdl32e.CYCLE_DT_S if end_s is None else end_s
+        end_s = r.chunk_start_s(r.n_chunks) if end_s is None else end_s
         if self.pending and self._revolution(np.array([end_s]))[0] > self.current:
             self._flush()
 

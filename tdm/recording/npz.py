@@ -29,7 +29,6 @@ import functools
 import io
 import math
 import os
-import re
 import zipfile
 import zlib
 from dataclasses import dataclass
@@ -39,6 +38,7 @@ import numpy as np
 
 from tdm.errors import RecordingError
 from tdm.recording.files import regular_file
+from groundfloor.npy_header import NPY_PREFIX_BYTES, numpy_header_text
 from groundfloor.zip_stored import StoredMember, stored_members
 
 __all__ = ["ArrayHeader", "NpzFile", "Unreadable", "read_layout", "load_arrays", "MAX_ARRAY_BYTES",
@@ -50,10 +50,6 @@ MAX_ARRAY_BYTES = 1 << 30
 MAX_HEADER_BYTES = 1 << 16
 #: Files up to this size are read whole, in one system call (a radar sweep is 2 MiB, a LiDAR sweep 0.6 MiB).
 IN_MEMORY_MAX_BYTES = 1 << 28
-#: The header text numpy writes (``np.lib.format``): ``{'descr': '<f4', 'fortran_order': False, 'shape': (3,), }``
-#: padded with spaces to a newline. Texts of another form go to numpy's parser.
-_NUMPY_HEADER_TEXT = re.compile(rb"\{'descr': '([<>|=]?[biufc]\d{1,2})', 'fortran_order': (True|False), "
-                                rb"'shape': \(((?:\d+, )*\d+,?|)\), \} *\n")
 _ZIP_ERRORS = (zipfile.BadZipFile, zlib.error, EOFError, OSError, ValueError, NotImplementedError, RuntimeError,
                KeyError)
 
@@ -135,10 +131,9 @@ def _decode_header(raw: bytes) -> tuple[tuple[int, ...], bool, np.dtype] | tuple
     or the format version when it is neither 1.0 nor 2.0. Cached: the arrays of a sweep, and of the
     sweeps of a run, repeat the same few headers."""
     if raw[:7] == b"\x93NUMPY\x01":
-        text = _NUMPY_HEADER_TEXT.fullmatch(raw, 10)
-        if text is not None:
-            shape = tuple(int(n) for n in text.group(3).split(b",") if n.strip())
-            return shape, text.group(2) == b"True", np.dtype(text.group(1).decode("ascii"))
+        decoded = numpy_header_text(raw, NPY_PREFIX_BYTES, len(raw))
+        if decoded is not None:
+            return decoded
     fp = io.BytesIO(raw)
     version = np.lib.format.read_magic(fp)
     if version == (1, 0):
