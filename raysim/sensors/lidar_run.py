@@ -13,6 +13,8 @@ same bytes whichever way it was split (tests/raysim/test_lidar_run.py).
 from __future__ import annotations
 
 import shutil
+from collections import deque
+from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 
 from raysim.recording.staging import atomic_path
@@ -24,10 +26,12 @@ PCAP_NAME = "hdl32e.pcap"
 PART_PREFIX = f".{PCAP_NAME}.part-"
 #: Fewest chunks left for which this process takes half of them (fewer: the second process renders them all).
 MIN_CHUNKS_TO_SHARE = 4
+#: Chunks handed to the writer thread and not yet written, at most.
+CHUNKS_IN_FLIGHT = 2
 #: The end of a run's claims before this process takes its share (the run's own end stops the render first).
 UNBOUNDED = 2**62
 
-__all__ = ["ChunkClaims", "join_pcap_parts", "render_chunks", "render_lidar"]
+__all__ = ["ChunkClaims", "ChunkWriter", "join_pcap_parts", "render_chunks", "render_lidar"]
 
 
 def render_chunks(renderer, out_dir: Path, progress=None, first: int = 0, end: int | None = None, claim=None) -> dict:
@@ -36,6 +40,9 @@ def render_chunks(renderer, out_dir: Path, progress=None, first: int = 0, end: i
     ``first`` 0: ``hdl32e.pcap`` itself; later: a part file (:data:`PART_PREFIX`) of records alone, to be
     appended (:func:`join_pcap_parts`). Sweeps: every revolution that ends within the chunks rendered
     and starts at or after the first chunk's revolution. ``claim``: as in ``chunks``.
+
+    A chunk's files are written on a writer thread while the next chunk renders (:class:`ChunkWriter`):
+    the ray engine and the compiled kernels release the GIL, so the two overlap on a second core.
     """
     from raysim.sensors.lidar_sweeps import LidarSweeps
 
@@ -43,22 +50,64 @@ def render_chunks(renderer, out_dir: Path, progress=None, first: int = 0, end: i
     start_s = renderer.chunk_start_s(first)
     # from the revolution under way at the first chunk: its first points are in the chunk before
     sweeps = LidarSweeps(renderer, lidar_dir / "sweeps", from_s=start_s)
-    counts = {"packets": 0, "position_packets": 0}
+    counts = {"packets": 0, "position_packets": 0, "chunks": 0}
     path = lidar_dir / (PCAP_NAME if first == 0 else f"{PART_PREFIX}{first:06d}")
     frames_before = first * renderer.chunk_packets + renderer._positions_before(first)[1]
-    last = first
     with atomic_path(path) as tmp, open(tmp, "wb") as handle:
         pcap = PcapWriter(handle, header=first == 0, frames_before=frames_before)
-        for chunk in renderer.chunks(progress, first=max(first - 1, 0), end=end, claim=claim):
+
+        def write(chunk) -> None:  # on the writer thread, one chunk after another in order
             sweeps.add(chunk)
             if chunk.time_s[0] < start_s:  # the chunk before the part: its sweep points only
-                continue
+                return
             renderer._write_in_order(pcap, chunk.payloads, chunk.sent_s, chunk.position_times_s)
             counts["packets"] += chunk.payloads.shape[0]
             counts["position_packets"] += len(chunk.position_times_s)
-            last += 1
-        sweeps.finish(renderer.chunk_start_s(last))
+            counts["chunks"] += 1
+
+        with ChunkWriter(write) as writer:
+            for chunk in renderer.chunks(progress, first=max(first - 1, 0), end=end, claim=claim):
+                writer.put(chunk)
+        sweeps.finish(renderer.chunk_start_s(first + counts.pop("chunks")))
     return {**counts, **sweeps.counts}
+
+
+class ChunkWriter:
+    """One writer thread that takes chunks in order; at most :data:`CHUNKS_IN_FLIGHT` wait for it.
+
+    Use as a context manager: leaving it waits for every chunk put (and raises the first fault of the
+    writer, if the block itself did not raise). Memory stays flat: :meth:`put` waits while the writer
+    is :data:`CHUNKS_IN_FLIGHT` chunks behind.
+
+    Parameters
+    ----------
+    write : callable
+        Called with each chunk, on the writer thread, in the order the chunks were put.
+    """
+
+    def __init__(self, write):
+        self.write = write
+        self._pool = ThreadPoolExecutor(1, thread_name_prefix="lidar-writer")
+        self._pending: deque[Future] = deque()
+
+    def put(self, chunk) -> None:
+        """Hand ``chunk`` to the writer (after waiting for the oldest, if too many are pending)."""
+        while len(self._pending) >= CHUNKS_IN_FLIGHT:
+            self._pending.popleft().result()
+        self._pending.append(self._pool.submit(self.write, chunk))
+
+    def __enter__(self) -> "ChunkWriter":
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        try:
+            if exc_type is None:
+                while self._pending:
+                    self._pending.popleft().result()
+        finally:
+            for future in self._pending:  # leaving by an exception: drop what has not started
+                future.cancel()
+            self._pool.shutdown(wait=True)
 
 
 def join_pcap_parts(lidar_dir: Path) -> None:

@@ -14,7 +14,8 @@ from raysim.materials import material_index
 from raysim.scenario import load_scenario, with_overrides
 from raysim.sensors.carrier import CarrierScene
 from raysim.sensors.lidar import LidarRenderer
-from raysim.sensors.lidar_run import ChunkClaims, MIN_CHUNKS_TO_SHARE, join_pcap_parts, render_chunks
+from raysim.sensors.lidar_run import (CHUNKS_IN_FLIGHT, ChunkClaims, ChunkWriter, MIN_CHUNKS_TO_SHARE, join_pcap_parts,
+                                     render_chunks)
 from raysim.world import World
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -82,3 +83,80 @@ def test_claims_split_what_is_left():
     for i in range(30 - MIN_CHUNKS_TO_SHARE + 1):
         late.claim(i)
     assert late.take_later_half(30) == (30, 30)  # too few left to share: all the second process's
+
+
+# ------------------------------------------------------------------ the writer thread
+
+
+def test_writer_takes_chunks_in_order_and_at_most_two_wait():
+    import threading
+    import time
+
+    written, waiting = [], []
+    gate = threading.Event()
+
+    def write(chunk):
+        gate.wait(5)
+        written.append(chunk)
+
+    writer = ChunkWriter(write)
+    with writer:
+        for i in range(CHUNKS_IN_FLIGHT):
+            writer.put(i)
+        waiting.append(len(writer._pending))
+        blocked = threading.Thread(target=writer.put, args=(CHUNKS_IN_FLIGHT,))
+        blocked.start()
+        time.sleep(0.2)
+        assert blocked.is_alive()  # a third chunk waits for the first to be written
+        gate.set()
+        blocked.join(5)
+        for i in range(CHUNKS_IN_FLIGHT + 1, 10):
+            writer.put(i)
+    assert written == list(range(10))
+    assert waiting == [CHUNKS_IN_FLIGHT]
+
+
+def test_a_writer_fault_reaches_the_render():
+    def write(chunk):
+        if chunk == 3:
+            raise OSError(28, "No space left on device")
+
+    with pytest.raises(OSError, match="No space left"):
+        with ChunkWriter(write) as writer:
+            for i in range(10):
+                writer.put(i)
+
+
+def test_a_fault_while_rendering_stops_the_writer():
+    written = []
+
+    def write(chunk):
+        written.append(chunk)
+
+    with pytest.raises(KeyboardInterrupt):
+        with ChunkWriter(write) as writer:
+            for i in range(5):
+                writer.put(i)
+            raise KeyboardInterrupt
+    assert written == list(range(len(written))) and len(written) <= 5
+    assert writer._pool._shutdown
+
+
+def test_the_writer_thread_changes_no_byte(whole, tmp_path, monkeypatch):
+    """The same run with each chunk written at once, on the render's own thread, gives the same files and counts."""
+    import raysim.sensors.lidar_run as lidar_run
+
+    class AtOnce:
+        def __init__(self, write):
+            self.put = write
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            return None
+
+    monkeypatch.setattr(lidar_run, "ChunkWriter", AtOnce)
+    out, counts = whole
+    assert render_chunks(_renderer(1.05), tmp_path) == counts
+    assert _digests(tmp_path / "lidar") == _digests(out / "lidar")
