@@ -50,21 +50,38 @@ def peak_memory_mb(duration_s: float, sensors: str) -> float:
 
 def frozen_scene_rays_per_s(objects, rays: np.ndarray, t_s: float, repeats: int) -> float:
     """Raw Open3D ``cast_rays`` of (N, 6) float32 world rays against every object frozen at its pose at ``t_s``."""
-    import open3d as o3d
+    raw = FrozenScene(objects, rays, t_s)
+    return rays.shape[0] / statistics.median(raw.sample(repeats))
 
-    scene = o3d.t.geometry.RaycastingScene()
-    for obj in objects:
-        poses = obj.motion.poses(np.array([t_s]))
-        vertices = obj.mesh.vertices_m @ poses.rotation()[0].T + poses.position_m[0]
-        scene.add_triangles(o3d.core.Tensor(vertices.astype(np.float32)), o3d.core.Tensor(obj.mesh.faces.astype(np.uint32)))
-    tensor = o3d.core.Tensor(np.ascontiguousarray(rays, dtype=np.float32))
-    scene.cast_rays(tensor)
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        scene.cast_rays(tensor)
-        times.append(time.perf_counter() - start)
-    return rays.shape[0] / statistics.median(times)
+
+class FrozenScene:
+    """Every object frozen at its pose at ``t_s`` in one Open3D scene, and (N, 6) float32 world rays to cast at it.
+
+    :meth:`sample` times ``cast_rays`` of all the rays; a benchmark samples it before, between and after its
+    own timings, so that the raw figure sees the same state of a shared machine as the renderer's.
+    """
+
+    def __init__(self, objects, rays: np.ndarray, t_s: float):
+        import open3d as o3d
+
+        self.scene = o3d.t.geometry.RaycastingScene()
+        for obj in objects:
+            poses = obj.motion.poses(np.array([t_s]))
+            vertices = obj.mesh.vertices_m @ poses.rotation()[0].T + poses.position_m[0]
+            self.scene.add_triangles(o3d.core.Tensor(vertices.astype(np.float32)),
+                                     o3d.core.Tensor(obj.mesh.faces.astype(np.uint32)))
+        self.tensor = o3d.core.Tensor(np.ascontiguousarray(rays, dtype=np.float32))
+        self.n_rays = rays.shape[0]
+        self.scene.cast_rays(self.tensor)
+
+    def sample(self, repeats: int) -> list[float]:
+        """Wall time of each of ``repeats`` casts of all the rays, s."""
+        times = []
+        for _ in range(repeats):
+            start = time.perf_counter()
+            self.scene.cast_rays(self.tensor)
+            times.append(time.perf_counter() - start)
+        return times
 
 
 def publish(title: str, intro: list[str], rows: list[tuple[str, str]], out: Path, json_path: Path | None,
