@@ -1,4 +1,4 @@
-"""The directory of a plain zip archive in memory, read without :mod:`zipfile`'s per-file machinery.
+"""Plain zip archives of stored members, read (in memory) and written without :mod:`zipfile`'s per-file machinery.
 
 Sweep files are ``.npz`` archives whose members are all stored (uncompressed): how ``np.savez`` and
 raysim write them. For such an archive, held whole in memory, :func:`stored_members` gives each
@@ -8,14 +8,21 @@ the central directory and each member's local header (PKWARE, APPNOTE.TXT 6.3.10
 an archive comment, data before the archive, a directory or a local header that does not add up)
 gives None, and the caller reads it with :mod:`zipfile`, which also says what is wrong with a
 damaged one: the errors stay :mod:`zipfile`'s.
+
+:func:`stored_archive` gives the bytes of such an archive as a list of buffers to write one after
+another: the bytes :class:`zipfile.ZipFile` writes for the same members stored with ``writestr`` of a
+:class:`zipfile.ZipInfo` (version 2.0 made and needed, made on Unix, the members' time, no extra
+fields, no comments), with one CRC-32 pass over each member's data and no seeking back.
 """
 
 from __future__ import annotations
 
 import struct
+import zlib
 from dataclasses import dataclass
+from typing import Sequence
 
-__all__ = ["StoredMember", "stored_members"]
+__all__ = ["StoredMember", "stored_archive", "stored_members"]
 
 #: End of central directory record (no comment): signature, disk numbers, entry counts, size and offset.
 _END = struct.Struct("<4s4H2LH")
@@ -30,6 +37,11 @@ _FLAGS_NOT_PLAIN = 0x0001 | 0x0008
 _STORED = 0
 #: A 2- or 4-byte field at its maximum marks a zip64 value kept elsewhere.
 _ZIP64_MARKS = (0xFFFF, 0xFFFFFFFF)
+#: Version made by and needed to extract (2.0, as zipfile writes for stored members), and the system made on (Unix).
+_VERSION = 20
+_UNIX = 3
+#: Largest member or archive written without zip64 records (zipfile's own threshold: 1.05 x size over 2 GiB - 1).
+_PLAIN_MAX_BYTES = int((2**31 - 1) / 1.05)
 
 
 @dataclass(frozen=True)
@@ -104,3 +116,52 @@ def stored_members(data: bytes) -> list[StoredMember] | None:
         member, at = found
         members.append(member)
     return members if at == offset + size else None
+
+
+def stored_archive(members: Sequence[tuple[str, Sequence[memoryview | bytes]]], date_time: tuple[int, ...],
+                   external_attr: int) -> list[memoryview | bytes]:
+    """The bytes of a plain archive of stored members, as buffers to be written in order.
+
+    Parameters
+    ----------
+    members : sequence of (str, sequence of buffer)
+        Each member's name (ASCII) and its data in pieces (concatenated in the archive), in order.
+    date_time : tuple of 6 int
+        Every member's modification time (year from 1980, month, day, hour, minute, second).
+    external_attr : int
+        Every member's external attributes (Unix mode in the upper 16 bits).
+
+    Returns
+    -------
+    list of buffer
+        Local headers, data and central directory; the pieces are the callers' buffers, not copies.
+
+    Raises
+    ------
+    ValueError
+        A name that is not ASCII, or an archive too large for plain records (zip64 is not written).
+    """
+    y, mo, d, h, mi, sec = date_time
+    dosdate, dostime = (y - 1980) << 9 | mo << 5 | d, h << 11 | mi << 5 | sec // 2
+    out: list[memoryview | bytes] = []
+    directory: list[bytes] = []
+    offset = 0
+    for name, pieces in members:
+        if not name.isascii():
+            raise ValueError(f"zip member name {name!r} is not ASCII")
+        encoded = name.encode("ascii")
+        size, crc = 0, 0
+        for piece in pieces:
+            crc = zlib.crc32(piece, crc)
+            size += memoryview(piece).nbytes
+        if size > _PLAIN_MAX_BYTES or offset > _PLAIN_MAX_BYTES:
+            raise ValueError(f"zip member {name!r} or its offset is too large for a plain archive")
+        out.append(_LOCAL.pack(_LOCAL_SIGNATURE, _VERSION, 0, 0, _STORED, dostime, dosdate, crc, size, size,
+                               len(encoded), 0) + encoded)
+        out.extend(pieces)
+        directory.append(_CENTRAL.pack(_CENTRAL_SIGNATURE, _VERSION, _UNIX, _VERSION, 0, 0, _STORED, dostime, dosdate,
+                                       crc, size, size, len(encoded), 0, 0, 0, 0, external_attr, offset) + encoded)
+        offset += _LOCAL.size + len(encoded) + size
+    central = b"".join(directory)
+    end = _END.pack(_END_SIGNATURE, 0, 0, len(directory), len(directory), len(central), offset, 0)
+    return out + [central + end]

@@ -6,15 +6,16 @@ and writes atomically.
 
 The arrays' bytes go from their own memory into the archive: no ``.npy`` image is
 built in memory first, and an array given in pieces (a LiDAR revolution gathered
-from two chunks) is written piece after piece, never concatenated. The file is the
-one ``numpy.lib.format.write_array`` and ``ZipFile.writestr`` would give
-(``tests/raysim/test_recording_writers.py`` holds the two to it).
+from two chunks) is written piece after piece, never concatenated. The zip records
+are :func:`groundfloor.zip_stored.stored_archive`'s, written front to back (zipfile
+writes each member's header twice, seeking back for its CRC: a sweep file took 92
+writes). The file is the one ``numpy.lib.format.write_array`` and ``ZipFile.writestr``
+would give (``tests/raysim/test_npz_pieces.py`` holds the two to it).
 """
 
 from __future__ import annotations
 
 import io
-import zipfile
 from pathlib import Path
 from typing import Mapping, Sequence
 
@@ -22,10 +23,12 @@ import numpy as np
 
 from groundfloor.recording import SweepSchema, sweep_file_name
 from groundfloor.npy_header import NPY_PREFIX_BYTES, numpy_header_text
-from groundfloor.zip_stored import stored_members
+from groundfloor.zip_stored import stored_archive, stored_members
 from raysim.recording.staging import atomic_path
 
 _EPOCH = (1980, 1, 1, 0, 0, 0)
+#: The members' Unix mode (rw-r--r--), in the zip entries' external attributes.
+_MODE = 0o644 << 16
 
 
 def npy_header(dtype: np.dtype, shape: tuple[int, ...]) -> bytes:
@@ -47,19 +50,16 @@ def write_npz_pieces(path: Path, pieces: Mapping[str, Sequence[np.ndarray]]) -> 
         Name -> one or more arrays of one dtype, equal in every dimension but the first
         (concatenated along it), in the order the members are written.
     """
-    with atomic_path(Path(path)) as tmp, zipfile.ZipFile(tmp, "w", compression=zipfile.ZIP_STORED) as archive:
-        for name, parts in pieces.items():
-            parts = [np.ascontiguousarray(p) for p in parts]  # (at least 1-d, as write_npz always wrote)
-            shape = (sum(p.shape[0] for p in parts),) + parts[0].shape[1:]
-            header = npy_header(parts[0].dtype, shape)
-            info = zipfile.ZipInfo(f"{name}.npy", date_time=_EPOCH)
-            info.external_attr = 0o644 << 16
-            info.file_size = len(header) + sum(p.nbytes for p in parts)  # as writestr sets it
-            with archive.open(info, mode="w") as member:
-                member.write(header)
-                for part in parts:
-                    if part.nbytes:
-                        member.write(memoryview(part).cast("B"))
+    members = []
+    for name, parts in pieces.items():
+        parts = [np.ascontiguousarray(p) for p in parts]  # (at least 1-d, as write_npz always wrote)
+        shape = (sum(p.shape[0] for p in parts),) + parts[0].shape[1:]
+        members.append((f"{name}.npy", [npy_header(parts[0].dtype, shape)]
+                        + [memoryview(p).cast("B") for p in parts if p.nbytes]))
+    buffers = stored_archive(members, _EPOCH, _MODE)
+    with atomic_path(Path(path)) as tmp, open(tmp, "wb") as handle:
+        for buffer in buffers:
+            handle.write(buffer)
 
 
 def write_npz(path: Path, arrays: dict[str, np.ndarray]) -> None:
