@@ -84,13 +84,14 @@ def raw_embree(scenario, t_s: float) -> FrozenScene:
 
 #: Parts of a revolution timed by :func:`part_times`: (owner module, class or None, attribute, label).
 PARTS = (
-    ("raysim.sensors.lidar", "LidarRenderer", "_world_rays_compiled",
-     "world rays: beams and own-ship pose per firing (compiled)"),
+    ("raysim.sensors.lidar", "LidarRenderer", "_rays_past_own_ship",
+     "world rays and the own-ship beam table, one compiled pass (poses per cycle included)"),
     ("raysim.sensors.lidar", "LidarRenderer", "_world_rays", "world rays, numpy path (sub-rays, or RAYSIM_JIT=0)"),
     ("raysim.scene.engine", "Scene", "cast", "ray engine: cast into the world (Embree and its pre-pass)"),
     ("raysim.scene.engine", "Scene", "_prepare", "ray engine: its pre-pass (origin box, near table, cells, sea)"),
     ("raysim.scene.static", "StaticPart", "merge_some", "ray engine: the static scene's cast (Embree) and merge"),
-    ("raysim.sensors.lidar", "LidarRenderer", "_cast_past_own_ship", "own-ship beam table and the cast"),
+    ("raysim.sensors.lidar", "LidarRenderer", "_cast_past_own_ship", "own-ship beam table and the cast, numpy path"),
+    ("raysim.sensors.lidar", "LidarRenderer", "_cycle_maps", "own-ship poses per cycle (numpy)"),
     ("raysim.sea", "FoamField", "is_foam", "foam field (raysim.sea)"),
     ("raysim.sensors.lidar", "LidarRenderer", "_world_echoes", "echo physics, foam included"),
     ("raysim.sensors.lidar", "LidarRenderer", "_returns", "returns (echo selection, noise, quantisation)"),

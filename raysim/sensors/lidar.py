@@ -165,20 +165,21 @@ class LidarRenderer(LidarGeometry):
         k = self.offsets.shape[0]
         f = c * hdl32e.N_LASERS
         n = f * k
-        if jit.ENABLED and self.own_table is not None:  # one ray per beam, the own ship from its table
-            o_w, d_w, t_firing = self._world_rays_compiled(cycle_time_s, firing_azimuth)
+        # candidate echoes per firing: K sub-rays and, in weather, one false echo near the sensor
+        cand = _Candidates.empty(f, k + (1 if self.alpha > 0 else 0))
+        if jit.ENABLED and self.own_table is not None:  # one ray per beam, the own ship from its table: one pass
+            free, cast = self._rays_past_own_ship(cycle_time_s, firing_azimuth, cand)
+            hits, own_body = self._cast(cast), None
         else:
             origins_s, directions_s = self._sensor_rays(firing_azimuth)
             o_w, d_w, t_firing = self._world_rays(cycle_time_s, origins_s, directions_s)
-        rays = _Rays(o_w.reshape(n, 3), d_w.reshape(n, 3),
-                     np.repeat(t_firing.reshape(-1), k) if k > 1 else t_firing.reshape(-1))
-        # candidate echoes per firing: K sub-rays and, in weather, one false echo near the sensor
-        cand = _Candidates.empty(f, k + (1 if self.alpha > 0 else 0))
-        if self.own_table is not None:
-            hits, free, own_body = self._cast_past_own_ship(cand, rays, firing_azimuth)
-        else:
-            hits, free, own_body = self._cast_with_own_ship(rays, origins_s, directions_s)
-        self._world_echoes(cand, rays, hits, free, own_body, k)
+            rays = _Rays(o_w.reshape(n, 3), d_w.reshape(n, 3),
+                         np.repeat(t_firing.reshape(-1), k) if k > 1 else t_firing.reshape(-1))
+            if self.own_table is not None:
+                hits, free, cast, own_body = self._cast_past_own_ship(cand, rays, firing_azimuth)
+            else:
+                hits, free, cast, own_body = self._cast_with_own_ship(rays, origins_s, directions_s)
+        self._world_echoes(cand, cast, hits, free, own_body, k)
         if self.alpha > 0:
             self._false_echoes(cand, f, k)
         units, refl, oid, src = self._returns(cand, f)
@@ -186,18 +187,18 @@ class LidarRenderer(LidarGeometry):
         to_c = lambda a: np.moveaxis(a.reshape(shape), 0, 1)  # noqa: E731
         return Firings(cycle_time_s, block_azimuth, firing_azimuth, to_c(units), to_c(refl), to_c(oid), to_c(src))
 
+    def _cast(self, rays: _Rays):
+        """The world's first hits of ``rays`` (the own ship's beams already answered), to the range limit and margin."""
+        return self.scene.world.cast(rays.origins_m, rays.directions, rays.times_s,
+                                     max_range_m=self.cfg.range_max_m + CAST_RANGE_MARGIN_M)
+
     def _cast_past_own_ship(self, cand: _Candidates, rays: _Rays, firing_azimuth: np.ndarray):
         """The own ship's echoes from the beam table into candidate 0; only the other rays go into the world.
 
-        Returns the world's hits, the indices of the rays cast into the world, and None (no
-        own-ship body-frame hits among them).
+        The numpy path of :meth:`_rays_past_own_ship`. Returns the world's hits, the indices of the rays
+        cast into the world, those rays, and None (no own-ship body-frame hits among them).
         """
         t = self.own_table
-        if jit.ENABLED:
-            free, o_free, d_free, t_free = lidar_kernels.past_own_ship(
-                firing_azimuth, t, rays.origins_m, rays.directions, rays.times_s, cand)
-            hits = self.scene.world.cast(o_free, d_free, t_free, max_range_m=self.cfg.range_max_m + CAST_RANGE_MARGIN_M)
-            return hits, free, None
         # gathers by np.take: the same values as fancy indexing, several times faster on these sizes
         key = (firing_azimuth.astype(np.int32) * hdl32e.N_LASERS + np.arange(hdl32e.N_LASERS, dtype=np.int32)).reshape(-1)
         on_own = np.take(t["hit"], key)
@@ -213,29 +214,29 @@ class LidarRenderer(LidarGeometry):
         cand.byte[:, 0][own] = np.take(t["byte"], key_own)
         cand.object_id[:, 0][own] = t["object_id"]
         free = np.flatnonzero(~on_own)
-        hits = self.scene.world.cast(np.take(rays.origins_m, free, axis=0), np.take(rays.directions, free, axis=0),
-                                     np.take(rays.times_s, free), max_range_m=self.cfg.range_max_m + CAST_RANGE_MARGIN_M)
-        return hits, free, None
+        cast = _Rays(np.take(rays.origins_m, free, axis=0), np.take(rays.directions, free, axis=0), np.take(rays.times_s, free))
+        return self._cast(cast), free, cast, None
 
     def _cast_with_own_ship(self, rays: _Rays, origins_s: np.ndarray, directions_s: np.ndarray):
         """Every ray cast, the own ship in its body frame (sub-rays: no beam table).
 
-        Returns the hits, the indices of all rays, and ``(on_carrier, body-frame directions)``.
+        Returns the hits, the indices of all rays, the rays, and ``(on_carrier, body-frame directions)``.
         """
         n = rays.origins_m.shape[0]
         o_b = origins_s.reshape(n, 3) @ self.mount_rotation.T + self.mount_translation
         d_b = directions_s.reshape(n, 3) @ self.mount_rotation.T
         hits, on_carrier = self.scene.cast(rays.origins_m, rays.directions, rays.times_s, o_b, d_b,
                                            max_range_m=self.cfg.range_max_m + CAST_RANGE_MARGIN_M)
-        return hits, np.arange(n), (on_carrier, d_b)
+        return hits, np.arange(n), rays, (on_carrier, d_b)
 
-    def _world_echoes(self, cand: _Candidates, rays: _Rays, hits, free: np.ndarray, own_body, k: int) -> None:
+    def _world_echoes(self, cand: _Candidates, cast: _Rays, hits, free: np.ndarray, own_body, k: int) -> None:
         """Echo range, power, byte, id and source of the rays that hit something, into the candidates.
 
-        Physics only on those rays (the sky is a large part of a sweep); calm sea is a mirror
-        (nothing comes back), foam a diffuse reflector.
+        ``cast``: the M rays cast (row i: the chunk's ray ``free[i]``), ``hits`` theirs. Physics only
+        on those rays (the sky is a large part of a sweep); calm sea is a mirror (nothing comes back),
+        foam a diffuse reflector.
         """
-        o_w, d_w, times = rays.origins_m, rays.directions, rays.times_s
+        o_w, d_w, times = cast.origins_m, cast.directions, cast.times_s
         if jit.ENABLED and k == 1 and own_body is None:  # two compiled passes around the foam test, the same values
             lidar_kernels.world_echoes(hits, free, o_w, d_w, times, self.materials, self.alpha, self.threshold,
                                        self.foam, cand, SEA_ID, SOURCE_SEA, FOAM_REFLECTANCE)
@@ -245,7 +246,7 @@ class LidarRenderer(LidarGeometry):
         r_h = np.take(hits.range_m, hit_local)
         obj_h = np.take(hits.object_id, hit_local)
         normal_h = np.take(hits.normal, hit_local, axis=0)
-        cos_h = np.abs(np.einsum("ij,ij->i", normal_h, np.take(d_w, h, axis=0)))
+        cos_h = np.abs(np.einsum("ij,ij->i", normal_h, np.take(d_w, hit_local, axis=0)))
         if own_body is not None:  # own-ship normals are in its body frame: use the body-frame direction
             on_carrier, d_b = own_body
             own_h = np.flatnonzero(on_carrier[h])
@@ -263,7 +264,7 @@ class LidarRenderer(LidarGeometry):
             foam_power = phys.echo_power(FOAM_REFLECTANCE * np.take(cos_h, on_sea), np.take(r_h, on_sea), self.alpha)
             could = np.take(on_sea, np.flatnonzero(foam_power >= self.threshold))
             if could.size:
-                rays_c = np.take(h, could)
+                rays_c = np.take(hit_local, could)
                 r_c = np.take(r_h, could)
                 o_c, d_c = np.take(o_w, rays_c, axis=0), np.take(d_w, rays_c, axis=0)
                 foam = self.foam.is_foam(o_c[:, 0] + r_c * d_c[:, 0], o_c[:, 1] + r_c * d_c[:, 1], np.take(times, rays_c))

@@ -1,9 +1,10 @@
 """Compiled kernels of the LiDAR renderer (:mod:`raysim.jit`), each beside the numpy code it replaces.
 
-:func:`world_rays` is :meth:`raysim.sensors.lidar.LidarRenderer._world_rays` for one ray per
-beam, with :func:`groundfloor.hdl32e.beam_directions` folded in: a firing's beam from the
-encoder-step tables, then the own-ship's affine map at the cycle start plus its change over
-the cycle times the firing's fraction of it, in the numpy path's order of operations.
+:func:`rays_past_own_ship` is :meth:`raysim.sensors.lidar.LidarRenderer._world_rays` for one ray
+per beam, with :func:`groundfloor.hdl32e.beam_directions` folded in (:func:`_ray`: a firing's beam
+from the encoder-step tables, then the own-ship's affine map at the cycle start plus its change over
+the cycle times the firing's fraction of it, in the numpy path's order of operations), fused with the
+own ship's beam-table lookups: a ray the own ship stops is never written out, the others once.
 """
 
 from __future__ import annotations
@@ -20,54 +21,21 @@ DEG_PER_STEP = 0.01
 
 
 @kernel
-def _world_rays(firing_az, cos_el, sin_el, cos_az, sin_az, z_offset_m, a0, da, frac, origins_out, directions_out):
-    n_cycles, n_lasers = firing_az.shape
-    for c in range(n_cycles):
-        for j in range(n_lasers):
-            step = firing_az[c, j]
-            d0 = cos_el[j] * cos_az[step]
-            d1 = -cos_el[j] * sin_az[step]
-            d2 = sin_el[j]
-            z = z_offset_m[j]
-            f = frac[j]
-            for i in range(3):
-                start = d0 * a0[c, 0, i] + d1 * a0[c, 1, i] + d2 * a0[c, 2, i]
-                change = d0 * da[c, 0, i] + d1 * da[c, 1, i] + d2 * da[c, 2, i]
-                directions_out[c, j, i] = start + change * f
-                start = z * a0[c, 2, i] + a0[c, 3, i]
-                change = z * da[c, 2, i] + da[c, 3, i]
-                origins_out[c, j, i] = start + change * f
-
-
-def world_rays(firing_az: np.ndarray, cos_el: np.ndarray, sin_el: np.ndarray, cos_az: np.ndarray,
-               sin_az: np.ndarray, z_offset_m: np.ndarray, a0: np.ndarray, da: np.ndarray,
-               frac: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """World rays of C firing cycles of one ray per beam, in one pass.
-
-    Parameters
-    ----------
-    firing_az : (C, L) uint16
-        Encoder step (0.01 deg) of each firing, L lasers.
-    cos_el, sin_el, z_offset_m : (L,) float64
-        Each laser's elevation cosine and sine and its beam origin's height in the sensor frame, m.
-    cos_az, sin_az : (36000,) float64
-        Cosine and sine of each encoder step.
-    a0, da : (C, 4, 3) float64
-        The sensor -> world affine map at each cycle start (rows: R^T, then the origin in m) and its
-        change over the cycle.
-    frac : (L,) float64
-        Each firing's fraction of the cycle.
-
-    Returns
-    -------
-    origins_m, directions : (C, L, 3) float64
-        Ray origins in the world, m, and unit directions (to the map's interpolation).
-    """
-    shape = firing_az.shape + (3,)
-    origins, directions = np.empty(shape), np.empty(shape)
-    _world_rays(np.ascontiguousarray(firing_az), cos_el, sin_el, cos_az, sin_az, z_offset_m,
-                np.ascontiguousarray(a0), np.ascontiguousarray(da), frac, origins, directions)
-    return origins, directions
+def _ray(c, j, firing_az, cos_el, sin_el, cos_az, sin_az, z_offset_m, a0, da, frac, origin_out, direction_out):
+    """The world ray of laser ``j`` in cycle ``c`` into the (3,) outputs (the numpy path's order of operations)."""
+    step = firing_az[c, j]
+    d0 = cos_el[j] * cos_az[step]
+    d1 = -cos_el[j] * sin_az[step]
+    d2 = sin_el[j]
+    z = z_offset_m[j]
+    f = frac[j]
+    for i in range(3):
+        start = d0 * a0[c, 0, i] + d1 * a0[c, 1, i] + d2 * a0[c, 2, i]
+        change = d0 * da[c, 0, i] + d1 * da[c, 1, i] + d2 * da[c, 2, i]
+        direction_out[i] = start + change * f
+        start = z * a0[c, 2, i] + a0[c, 3, i]
+        change = z * da[c, 2, i] + da[c, 3, i]
+        origin_out[i] = start + change * f
 
 
 @kernel
@@ -106,87 +74,98 @@ def decoder_azimuths(block_az: np.ndarray, dual: bool) -> np.ndarray:
 
 
 @kernel
-def _past_own_ship(key, hit, wet, table_range, table_power, table_byte, own_id, origins, directions, times,
-                   cand_range, cand_power, cand_byte, cand_id, free, free_origins, free_directions, free_times):
+def _rays_past_own_ship(firing_az, cos_el, sin_el, cos_az, sin_az, z_offset_m, a0, da, frac, firing_times,
+                        hit, wet, table_range, table_power, table_byte, own_id,
+                        cand_range, cand_power, cand_byte, cand_id, free, free_origins, free_directions, free_times):
+    n_cycles, n_lasers = firing_az.shape
+    origin, direction = np.empty(3), np.empty(3)
     n_free = 0
-    for i in range(key.shape[0]):
-        k = key[i]
-        on_own = hit[k]
-        if on_own and wet[k]:  # the sea first? (raysim.scene.intersect_sea: -(oz / dz), kept where >= 0)
-            sea = -(origins[i, 2] / directions[i, 2])
-            if sea >= 0.0 and sea < np.float64(table_range[k]):
-                on_own = False
-        if on_own:
-            cand_range[i, 0] = table_range[k]
-            cand_power[i, 0] = table_power[k]
-            cand_byte[i, 0] = table_byte[k]
-            cand_id[i, 0] = own_id
-        else:
-            free[n_free] = i
-            for a in range(3):
-                free_origins[n_free, a] = origins[i, a]
-                free_directions[n_free, a] = directions[i, a]
-            free_times[n_free] = times[i]
-            n_free += 1
+    for c in range(n_cycles):
+        for j in range(n_lasers):
+            i = c * n_lasers + j
+            k = np.int64(firing_az[c, j]) * n_lasers + j
+            _ray(c, j, firing_az, cos_el, sin_el, cos_az, sin_az, z_offset_m, a0, da, frac, origin, direction)
+            on_own = hit[k]
+            if on_own and wet[k]:  # the sea first? (raysim.scene.intersect_sea: -(oz / dz), kept where >= 0)
+                sea = -(origin[2] / direction[2])
+                if sea >= 0.0 and sea < np.float64(table_range[k]):
+                    on_own = False
+            if on_own:
+                cand_range[i, 0] = table_range[k]
+                cand_power[i, 0] = table_power[k]
+                cand_byte[i, 0] = table_byte[k]
+                cand_id[i, 0] = own_id
+            else:
+                free[n_free] = i
+                for a in range(3):
+                    free_origins[n_free, a] = origin[a]
+                    free_directions[n_free, a] = direction[a]
+                free_times[n_free] = firing_times[c, j]
+                n_free += 1
     return n_free
 
 
-def past_own_ship(firing_az: np.ndarray, table: dict, origins_m: np.ndarray, directions: np.ndarray,
-                  times_s: np.ndarray, cand) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """The own ship's echoes from its beam table into candidate column 0; the other rays gathered to be cast.
+def rays_past_own_ship(firing_az: np.ndarray, beams: tuple, a0: np.ndarray, da: np.ndarray, frac: np.ndarray,
+                       firing_times_s: np.ndarray, table: dict, cand) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Each firing's world ray (:func:`_ray`), answered from the own-ship beam table or gathered to be cast.
 
-    :meth:`raysim.sensors.lidar.LidarRenderer._cast_past_own_ship`'s lookups in one pass (one ray per beam).
+    :meth:`raysim.sensors.lidar.LidarRenderer._cast_past_own_ship`'s lookups fused with the world rays in one
+    pass (one ray per beam): the rays the own ship stops are never written out, the others only once.
 
     Parameters
     ----------
     firing_az : (C, 32) uint16
         Encoder step of each firing.
+    beams : tuple
+        ``(cos_el, sin_el, cos_az, sin_az, z_offset_m)``: each laser's elevation cosine and sine, (32,); the
+        cosine and sine of each encoder step, (36000,); each beam origin's height in the sensor frame, (32,) m.
+    a0, da : (C, 4, 3) float64
+        The sensor -> world affine map at each cycle start and its change over the cycle.
+    frac : (32,) float64
+        Each firing's fraction of the cycle.
+    firing_times_s : (C, 32) float64
+        Each firing's time, s.
     table : dict
         The own-ship beam table (``LidarRenderer._own_ship_table``), (36000 x 32,) per beam.
-    origins_m, directions : (N, 3) float64
-        The N = 32 C rays in the world, m and unit.
-    times_s : (N,) float64
-        Each ray's time, s.
     cand : raysim.sensors.lidar._Candidates
-        (N, E) candidates, written in column 0 where the own ship answers.
+        (32 C, E) candidates, written in column 0 where the own ship answers.
 
     Returns
     -------
     free : (M,) int64
-        The rays not stopped by the own ship, in order.
+        The rays not stopped by the own ship (firing index), in order.
     origins_m, directions, times_s : (M, 3), (M, 3), (M,)
-        Those rays.
+        Those rays in the world: m, unit, s.
     """
-    n = origins_m.shape[0]
-    key = (firing_az.astype(np.int64) * firing_az.shape[1] + np.arange(firing_az.shape[1])).reshape(-1)
+    n = firing_az.size
     free = np.empty(n, dtype=np.int64)
     free_o, free_d, free_t = np.empty((n, 3)), np.empty((n, 3)), np.empty(n)
-    m = _past_own_ship(key, table["hit"], table["wet"], table["range_m"], table["power"], table["byte"],
-                       np.int32(table["object_id"]), origins_m, directions, times_s, cand.range_m, cand.power,
-                       cand.byte, cand.object_id, free, free_o, free_d, free_t)
+    m = _rays_past_own_ship(np.ascontiguousarray(firing_az), *beams, np.ascontiguousarray(a0), np.ascontiguousarray(da),
+                            frac, np.ascontiguousarray(firing_times_s), table["hit"], table["wet"], table["range_m"],
+                            table["power"], table["byte"], np.int32(table["object_id"]), cand.range_m, cand.power,
+                            cand.byte, cand.object_id, free, free_o, free_d, free_t)
     return free[:m], free_o[:m], free_d[:m], free_t[:m]
 
 
 @kernel
-def _echo_geometry(hit_rows, free, ranges, normals, materials, object_ids, origins, directions, times,
+def _echo_geometry(hit_rows, ranges, normals, materials, object_ids, origins, directions, times,
                    reflectance_table, sea_id, foam_reflectance, attenuation, threshold,
                    cos_out, reflectance_out, foam_rows, foam_x, foam_y, foam_t):
     n_foam = 0
     for j in range(hit_rows.shape[0]):
         row = hit_rows[j]
-        h = free[row]
         r = ranges[row]
         # numpy's einsum("ij,ij->i") sums a row of 3 as (x + z) + y: the same order gives the same bits
-        cos = abs((np.float64(normals[row, 0]) * directions[h, 0] + np.float64(normals[row, 2]) * directions[h, 2])
-                  + np.float64(normals[row, 1]) * directions[h, 1])
+        cos = abs((np.float64(normals[row, 0]) * directions[row, 0] + np.float64(normals[row, 2]) * directions[row, 2])
+                  + np.float64(normals[row, 1]) * directions[row, 1])
         cos_out[j] = cos
         if object_ids[row] == sea_id:  # calm water: a mirror; foam where a foam echo could be detected at all
             reflectance_out[j] = 0.0
             if ((foam_reflectance * cos) * attenuation[j]) / (r * r) >= threshold:
                 foam_rows[n_foam] = j
-                foam_x[n_foam] = origins[h, 0] + r * directions[h, 0]
-                foam_y[n_foam] = origins[h, 1] + r * directions[h, 1]
-                foam_t[n_foam] = times[h]
+                foam_x[n_foam] = origins[row, 0] + r * directions[row, 0]
+                foam_y[n_foam] = origins[row, 1] + r * directions[row, 1]
+                foam_t[n_foam] = times[row]
                 n_foam += 1
         else:
             reflectance_out[j] = np.float64(reflectance_table[materials[row]])
@@ -229,8 +208,8 @@ def world_echoes(hits, free: np.ndarray, origins_m: np.ndarray, directions: np.n
         The world's first hits of the M rays cast.
     free : (M,) int64
         The chunk's ray index of each ray cast.
-    origins_m, directions : (N, 3) float64; times_s : (N,) float64
-        The chunk's rays.
+    origins_m, directions : (M, 3) float64; times_s : (M,) float64
+        The rays cast (row i: the chunk's ray ``free[i]``).
     materials : dict
         :func:`raysim.materials.material_table`.
     alpha_per_m, threshold : float
@@ -250,7 +229,7 @@ def world_echoes(hits, free: np.ndarray, origins_m: np.ndarray, directions: np.n
     cos_h, reflectance = np.empty(m), np.empty(m)
     foam_rows, foam_x, foam_y, foam_t = np.empty(m, np.int64), np.empty(m), np.empty(m), np.empty(m)
     normals = np.ascontiguousarray(hits.normal)
-    n_foam = _echo_geometry(hit_rows, free, ranges, normals, hits.material, hits.object_id, origins_m, directions,
+    n_foam = _echo_geometry(hit_rows, ranges, normals, hits.material, hits.object_id, origins_m, directions,
                             times_s, materials["reflectance_905nm"], sea_id, foam_reflectance, attenuation, threshold,
                             cos_h, reflectance, foam_rows, foam_x, foam_y, foam_t)
     if n_foam:
@@ -381,4 +360,4 @@ def points(distance_units: np.ndarray, reflectivity: np.ndarray, object_id: np.n
     return arrays, cycle
 
 
-__all__ = ["decoder_azimuths", "past_own_ship", "points", "single_returns", "world_echoes", "world_rays"]
+__all__ = ["decoder_azimuths", "points", "rays_past_own_ship", "single_returns", "world_echoes"]

@@ -153,17 +153,22 @@ class LidarGeometry:
         np.subtract(pos[1:], pos[:-1], out=da[:, 3])
         return a0, da
 
-    def _world_rays_compiled(self, cycle_time_s: np.ndarray, firing_azimuth: np.ndarray):
-        """:meth:`_world_rays` of one ray per beam, beams included, in one compiled pass (:mod:`raysim.jit`).
+    def _rays_past_own_ship(self, cycle_time_s: np.ndarray, firing_azimuth: np.ndarray, cand):
+        """One ray per beam in one compiled pass (:mod:`raysim.jit`): each firing's world ray, the own ship's
+        echoes from its beam table into candidate column 0, the other rays gathered to be cast.
 
-        Returns (C, 32, 1, 3) origins (m) and directions in the world and (C, 32) firing times (s).
+        The compiled path of :meth:`_world_rays` (beams included) and ``_cast_past_own_ship``'s lookups.
+        Returns the (M,) indices of the rays to cast and those rays (a ``_Rays`` of (M, 3) origins, m,
+        unit directions and (M,) times, s).
         """
+        from raysim.sensors.lidar import _Rays
+
         a0, da = self._cycle_maps(cycle_time_s)
-        o_world, d_world = lidar_kernels.world_rays(
-            firing_azimuth, hdl32e.COS_ELEVATION, hdl32e.SIN_ELEVATION, hdl32e.COS_AZIMUTH_STEP,
-            hdl32e.SIN_AZIMUTH_STEP, hdl32e.beam_origins()[:, 2], a0, da, FIRING_FRACTION)
-        c = cycle_time_s.shape[0]
-        return o_world.reshape(c, hdl32e.N_LASERS, 1, 3), d_world.reshape(c, hdl32e.N_LASERS, 1, 3), _firing_times(cycle_time_s)
+        beams = (hdl32e.COS_ELEVATION, hdl32e.SIN_ELEVATION, hdl32e.COS_AZIMUTH_STEP, hdl32e.SIN_AZIMUTH_STEP,
+                 hdl32e.beam_origins()[:, 2])
+        free, o_free, d_free, t_free = lidar_kernels.rays_past_own_ship(
+            firing_azimuth, beams, a0, da, FIRING_FRACTION, _firing_times(cycle_time_s), self.own_table, cand)
+        return free, _Rays(o_free, d_free, t_free)
 
     # ------------------------------------------------------------------ physics
 

@@ -34,23 +34,69 @@ def renderer():
     return LidarRenderer(World(busy_open_sea(1.0)), scene=None)
 
 
-@pytest.mark.parametrize("t0_s", [0.0, 37.3, 251.9])
-def test_world_rays_kernel_is_the_numpy_path(renderer, t0_s):
-    c = 181 * hdl32e.BLOCKS_PER_PACKET
+def _cycles(renderer, t0_s: float, c: int):
     t = (int(t0_s / hdl32e.CYCLE_DT_S) + np.arange(c)) * hdl32e.CYCLE_DT_S
     block = hdl32e.block_azimuth_centideg(t, renderer.cfg.rotation_hz, renderer.cfg.azimuth0_deg)
     firing = hdl32e.decoder_azimuths_centideg(block.reshape(-1, hdl32e.BLOCKS_PER_PACKET)).reshape(-1, hdl32e.N_LASERS)
+    return t, firing
+
+
+def _no_own_ship(n_keys: int = 36000 * 32) -> dict:
+    return {"hit": np.zeros(n_keys, bool), "wet": np.zeros(n_keys, bool), "range_m": np.zeros(n_keys, np.float32),
+            "power": np.zeros(n_keys, np.float32), "byte": np.zeros(n_keys, np.uint8), "object_id": 0}
+
+
+@pytest.mark.parametrize("t0_s", [0.0, 37.3, 251.9])
+def test_world_rays_kernel_is_the_numpy_path(renderer, t0_s, monkeypatch):
+    """With no own ship in the beam table every firing's ray is gathered: the numpy path's rays, in order."""
+    from raysim.sensors.lidar import _Candidates
+
+    c = 181 * hdl32e.BLOCKS_PER_PACKET
+    t, firing = _cycles(renderer, t0_s, c)
     origins, directions = renderer._sensor_rays(firing)
     with single_blas_thread():
         o_np, d_np, t_np = renderer._world_rays(t, origins, directions)
-    o_k, d_k, t_k = renderer._world_rays_compiled(t, firing)
-    assert o_k.shape == o_np.shape == (c, hdl32e.N_LASERS, 1, 3) and d_k.shape == d_np.shape
+    monkeypatch.setattr(renderer, "own_table", _no_own_ship())
+    free, cast = renderer._rays_past_own_ship(t, firing, _Candidates.empty(c * hdl32e.N_LASERS, 1))
+    n = c * hdl32e.N_LASERS
+    assert np.array_equal(free, np.arange(n)) and cast.origins_m.shape == cast.directions.shape == (n, 3)
     # the origins' sums are the same operations; the directions' 3-term sums may differ from BLAS's in the last bit
-    assert np.array_equal(o_k, o_np) and np.array_equal(t_k, t_np)
-    assert np.max(np.abs(d_k - d_np)) <= 4 * np.finfo(float).eps
-    assert np.allclose(np.linalg.norm(d_k, axis=-1), 1.0, atol=1e-12)
-    # and the rays point where the encoder says: at t0 = 0 the own ship's yaw is its heading
-    assert np.isfinite(d_k).all()
+    assert np.array_equal(cast.origins_m, o_np.reshape(n, 3)) and np.array_equal(cast.times_s, t_np.reshape(n))
+    assert np.max(np.abs(cast.directions - d_np.reshape(n, 3))) <= 4 * np.finfo(float).eps
+    assert np.allclose(np.linalg.norm(cast.directions, axis=-1), 1.0, atol=1e-12)
+    assert np.isfinite(cast.directions).all()
+
+
+def test_fused_own_ship_pass_is_the_numpy_path(monkeypatch):
+    """busy_open_sea's real beam table over two revolutions: the compiled pass answers the same firings from the
+    own ship as the numpy path (range, power, byte, id) and gathers the same rays, in the same order."""
+    from raysim.sensors.lidar import _Candidates, _Rays
+
+    world = World(busy_open_sea(1.0))
+    lidar = LidarRenderer(world, CarrierScene(world.scene_objects(), sea_material=material_index("sea")))
+    monkeypatch.setattr(lidar, "_cast", lambda rays: None)  # the lookups only
+    c = 2 * 181 * hdl32e.BLOCKS_PER_PACKET
+    t, firing = _cycles(lidar, 3.1, c)
+    n = c * hdl32e.N_LASERS
+    cand_k, cand_np = _Candidates.empty(n, 1), _Candidates.empty(n, 1)
+    free_k, cast_k = lidar._rays_past_own_ship(t, firing, cand_k)
+    with single_blas_thread():
+        o, d, tf = lidar._world_rays(t, *lidar._sensor_rays(firing))
+    o, d = o.reshape(n, 3), d.reshape(n, 3)
+    # the numpy lookups on the kernel's own directions (which may differ from BLAS's in the last bit)
+    _, free_np, cast_np, _ = lidar._cast_past_own_ship(cand_np, _Rays(o, _scatter(d, free_k, cast_k.directions), tf.reshape(n)),
+                                                       firing)
+    assert np.array_equal(free_k, free_np) and 0.5 * n < free_k.size < n  # the own ship stops some beams
+    for name in ("range_m", "power", "byte", "object_id", "source"):
+        assert np.array_equal(getattr(cand_k, name), getattr(cand_np, name)), name
+    assert np.array_equal(cast_k.origins_m, cast_np.origins_m) and np.array_equal(cast_k.times_s, cast_np.times_s)
+    assert np.array_equal(cast_k.directions, cast_np.directions)
+
+
+def _scatter(full: np.ndarray, rows: np.ndarray, values: np.ndarray) -> np.ndarray:
+    out = full.copy()
+    out[rows] = values
+    return out
 
 
 def measured_firings(enabled: bool, monkeypatch, duration_s: float = 0.3):
@@ -91,30 +137,32 @@ def test_decoder_azimuths_kernel_is_the_decoders_arithmetic(dual):
         assert got.dtype == expected.dtype == np.uint16 and np.array_equal(got, expected)
 
 
-def test_past_own_ship_kernel_sends_wet_beams_to_the_sea():
-    """A synthetic beam table: beams 0-9 on the own ship at 5 m, 0-4 of them low on the hull (wet). Rays 20 cm
+def test_own_ship_pass_sends_wet_beams_to_the_sea():
+    """A synthetic beam table: beams 0-9 on the own ship at 5 m, 0-4 of them low on the hull (wet). Beams 20 cm
     above the sea looking down at 1/10 meet the sea at 2 m, before the hull: those wet beams go to the world,
     as do the beams off the ship; the others are the ship's, with its range, power, byte and id."""
     from raysim.sensors import lidar_kernels
     from raysim.sensors.lidar import _Candidates
 
-    n_keys = 36000 * 32
-    hit = np.zeros(n_keys, bool)
-    hit[:10] = True
-    wet = np.zeros(n_keys, bool)
-    wet[:5] = True
-    table = {"hit": hit, "wet": wet, "range_m": np.full(n_keys, 5.0, np.float32),
-             "power": np.full(n_keys, 0.25, np.float32), "byte": np.full(n_keys, 40, np.uint8), "object_id": 0}
-    firing_az = np.zeros((1, 32), np.uint16)  # keys 0..31
-    origins = np.tile([0.0, 0.0, 0.2], (32, 1))
-    directions = np.tile([np.sqrt(0.99), 0.0, -0.1], (32, 1))
-    directions[2] = [1.0, 0.0, 0.0]  # a wet beam level with the sea: it never meets it, the hull answers
-    times = np.arange(32) * 1e-6
+    table = _no_own_ship()
+    table["hit"][:10] = True
+    table["wet"][:5] = True
+    table.update(range_m=np.full(36000 * 32, 5.0, np.float32), power=np.full(36000 * 32, 0.25, np.float32),
+                 byte=np.full(36000 * 32, 40, np.uint8))
+    firing_az = np.zeros((1, 32), np.uint16)  # keys 0..31, azimuth step 0: along x
+    sin_el = np.full(32, -0.1)
+    sin_el[2] = 0.0  # a wet beam level with the sea: it never meets it, the hull answers
+    beams = (np.sqrt(1.0 - sin_el**2), sin_el, np.ones(36000), np.zeros(36000), np.zeros(32))
+    a0 = np.zeros((1, 4, 3))
+    a0[0, :3] = np.eye(3)
+    a0[0, 3] = [0.0, 0.0, 0.2]  # the sensor 20 cm above the sea, level
+    times = (np.arange(32) * 1e-6)[None, :]
     cand = _Candidates.empty(32, 1)
-    free, o_free, d_free, t_free = lidar_kernels.past_own_ship(firing_az, table, origins, directions, times, cand)
+    free, o_free, d_free, t_free = lidar_kernels.rays_past_own_ship(firing_az, beams, a0, np.zeros((1, 4, 3)),
+                                                                    np.zeros(32), times, table, cand)
     assert free.tolist() == [0, 1, 3, 4] + list(range(10, 32))
-    assert np.array_equal(o_free, origins[free]) and np.array_equal(d_free, directions[free])
-    assert np.array_equal(t_free, times[free])
+    assert np.array_equal(o_free, np.tile([0.0, 0.0, 0.2], (free.size, 1)))
+    assert np.allclose(d_free[:, 2], -0.1) and np.array_equal(t_free, times[0, free])
     own = [2, 5, 6, 7, 8, 9]
     assert np.all(cand.range_m[own, 0] == 5.0) and np.all(cand.power[own, 0] == 0.25)
     assert np.all(cand.byte[own, 0] == 40) and np.all(cand.object_id[own, 0] == 0)
@@ -145,7 +193,7 @@ def test_world_echoes_kernel_is_the_numpy_path(renderer, monkeypatch, alpha_per_
     normal[kind == 1] = [0.0, 0.0, 1.0]
     range_m = np.where(kind == 0, np.inf, rng.uniform(1.0, 110.0, m))
     hits = Hits(range_m, object_id, normal, material, np.zeros(m, np.int32))
-    rays = _Rays(o, d, t)
+    rays = _Rays(o[free], d[free], t[free])  # the rays cast
     monkeypatch.setattr(renderer, "alpha", alpha_per_m)
     monkeypatch.setattr(renderer.foam, "coverage", 0.3)  # plenty of foam to test
     results = []
