@@ -149,9 +149,12 @@ class Scene:
             if self.sea:
                 batch.sea_range = self._sea_range(batch, slice(None))
             return
-        parts = split_run(batch.n, self._workers, lambda a, b: origin_box(batch.origins[a:b]))
-        lo = np.min([p[0] for p in parts], axis=0)
-        hi = np.max([p[1] for p in parts], axis=0)
+        if jit.ENABLED:
+            lo, hi = kernels.origin_box(batch.origins)
+        else:
+            parts = split_run(batch.n, self._workers, lambda a, b: origin_box(batch.origins[a:b]))
+            lo = np.min([p[0] for p in parts], axis=0)
+            hi = np.max([p[1] for p in parts], axis=0)
         batch.origin_centre = (lo + hi) / 2
         batch.spread_m = float(np.linalg.norm(hi - lo) / 2) * (1 + 1e-9) + 1e-9
         near_table = self._static.near_table(batch) if self._static is not None else None

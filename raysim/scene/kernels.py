@@ -3,7 +3,8 @@
 :func:`prepass` is :meth:`raysim.scene.engine.Scene._prepass_part` in one pass per ray: the ray's
 direction cell (:func:`raysim.scene.geometry.direction_cells`, the same float32 steps), its range to
 the sea (:func:`raysim.scene.geometry.intersect_sea`) and whether the static near table lets it
-through. The values are the numpy path's, bit for bit (tests/raysim/test_scene_kernels.py).
+through. :func:`origin_box` is :func:`raysim.scene.geometry.origin_box` in one pass. The values are
+the numpy path's, bit for bit (tests/raysim/test_scene_kernels.py).
 """
 
 from __future__ import annotations
@@ -81,3 +82,28 @@ def prepass(origins: np.ndarray, directions: np.ndarray, max_range: np.ndarray |
 
 
 __all__ = ["prepass"]
+
+
+@kernel
+def _origin_box(origins, lo, hi):
+    for a in range(3):
+        lo[a] = np.inf
+        hi[a] = -np.inf
+    for i in range(origins.shape[0]):
+        for a in range(3):
+            v = origins[i, a]
+            if np.isnan(v):  # a NaN stays, as numpy's min and max keep it (no comparison with it holds)
+                lo[a] = v
+                hi[a] = v
+            else:
+                if v < lo[a]:
+                    lo[a] = v
+                if v > hi[a]:
+                    hi[a] = v
+
+
+def origin_box(origins: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per-axis min and max of (N, 3) float64 origins, N >= 1, m (:func:`raysim.scene.geometry.origin_box`)."""
+    lo, hi = np.empty(3), np.empty(3)
+    _origin_box(np.ascontiguousarray(origins, dtype=np.float64), lo, hi)
+    return lo, hi

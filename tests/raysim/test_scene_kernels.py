@@ -55,3 +55,19 @@ def test_prepass_without_sea_or_table():
     assert kernels.prepass(o, d, 50.0, None, cells, None, 0, 3000) is None
     d32 = d.T.astype(np.float32)
     assert np.array_equal(cells, direction_cells(d32[0], d32[1], d32[2]))
+
+
+def test_origin_box_is_numpys_min_and_max():
+    """Random origins (whole and in blocks), one origin, and a NaN, which numpy's min and max keep."""
+    from raysim.scene.geometry import origin_box
+
+    rng = np.random.default_rng(4)
+    for origins in (rng.normal(0.0, 50.0, (69_121, 3)), rng.normal(size=(1, 3)), rng.normal(size=(300, 3)) * 1e-300):
+        lo, hi = kernels.origin_box(origins)
+        lo_np, hi_np = origin_box(origins)
+        assert np.array_equal(lo, lo_np) and np.array_equal(hi, hi_np)
+    with_nan = rng.normal(size=(1000, 3))
+    with_nan[500, 1] = np.nan
+    lo, hi = kernels.origin_box(with_nan)
+    assert np.isnan(lo[1]) and np.isnan(hi[1]) and np.isfinite(lo[[0, 2]]).all()
+    assert lo[0] == with_nan[:, 0].min() and hi[2] == with_nan[:, 2].max()
