@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import datetime as dt
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -81,6 +82,20 @@ class _Rays:
     origins_m: np.ndarray
     directions: np.ndarray
     times_s: np.ndarray
+
+
+@dataclass
+class _Cast:
+    """A chunk's rays cast (:meth:`LidarRenderer._cast_stage`): the M rays cast, their hits and indices among
+    the chunk's N rays, the candidates with the own ship's echoes in, and the own ship's body-frame hits (or None)."""
+
+    cycle_time_s: np.ndarray
+    firing_azimuth: np.ndarray
+    cand: "_Candidates"
+    cast: _Rays
+    hits: object
+    free: np.ndarray
+    own_body: tuple | None
 
 
 @dataclass
@@ -160,7 +175,14 @@ class LidarRenderer(LidarGeometry):
         self.chunk_wall_s: list[tuple[float, float]] = []
 
     def measure(self, cycle_time_s: np.ndarray, block_azimuth: np.ndarray, firing_azimuth: np.ndarray) -> Firings:
-        """Cast and measure C firing cycles."""
+        """Cast and measure C firing cycles (:meth:`_cast_stage`, then :meth:`_echo_stage`)."""
+        return self._echo_stage(self._cast_stage(cycle_time_s, firing_azimuth), block_azimuth)
+
+    def _cast_stage(self, cycle_time_s: np.ndarray, firing_azimuth: np.ndarray) -> _Cast:
+        """The rays of C firing cycles into the world: the own ship's echoes answered, the rest cast.
+
+        No random numbers are drawn here, so a chunk's cast may run while the chunk before it is measured.
+        """
         c = cycle_time_s.shape[0]
         k = self.offsets.shape[0]
         f = c * hdl32e.N_LASERS
@@ -179,13 +201,21 @@ class LidarRenderer(LidarGeometry):
                 hits, free, cast, own_body = self._cast_past_own_ship(cand, rays, firing_azimuth)
             else:
                 hits, free, cast, own_body = self._cast_with_own_ship(rays, origins_s, directions_s)
-        self._world_echoes(cand, cast, hits, free, own_body, k)
+        return _Cast(cycle_time_s, firing_azimuth, cand, cast, hits, free, own_body)
+
+    def _echo_stage(self, stage: _Cast, block_azimuth: np.ndarray) -> Firings:
+        """The echoes of a cast's hits and the returns the sensor reports (this chunk's random streams)."""
+        c, k = stage.cycle_time_s.shape[0], self.offsets.shape[0]
+        f = c * hdl32e.N_LASERS
+        cand = stage.cand
+        self._world_echoes(cand, stage.cast, stage.hits, stage.free, stage.own_body, k)
         if self.alpha > 0:
             self._false_echoes(cand, f, k)
         units, refl, oid, src = self._returns(cand, f)
         shape = (units.shape[0], c, hdl32e.N_LASERS)
         to_c = lambda a: np.moveaxis(a.reshape(shape), 0, 1)  # noqa: E731
-        return Firings(cycle_time_s, block_azimuth, firing_azimuth, to_c(units), to_c(refl), to_c(oid), to_c(src))
+        return Firings(stage.cycle_time_s, block_azimuth, stage.firing_azimuth, to_c(units), to_c(refl), to_c(oid),
+                       to_c(src))
 
     def _cast(self, rays: _Rays):
         """The world's first hits of ``rays`` (the own ship's beams already answered), to the range limit and margin."""
@@ -444,39 +474,64 @@ class LidarRenderer(LidarGeometry):
         LidarChunk
             The chunk's firings, data packets and their send times, and the position packets due in it.
         """
-        chunk_packets = self.chunk_packets
         next_position_s = self._positions_before(first)[0]
         indices = range(first, self.n_chunks if end is None else min(end, self.n_chunks))
-        for index in (progress(indices) if progress else indices):
-            if claim is not None and not claim(index):
-                return
-            chunk_started = time.perf_counter()
-            first_packet = index * chunk_packets
-            packets_here = min(chunk_packets, self.n_packets - first_packet)
-            k0 = first_packet * self.cycles_per_packet
-            cycles = k0 + np.arange(packets_here * self.cycles_per_packet)
-            t = cycles * hdl32e.CYCLE_DT_S
-            block_az = hdl32e.block_azimuth_centideg(t, self.cfg.rotation_hz, self.cfg.azimuth0_deg)
-            blocks = hdl32e.BLOCKS_PER_PACKET
-            az_blocks = (np.repeat(block_az, DUAL_RETURNS) if self.dual else block_az).reshape(-1, blocks)
-            firing_az = (lidar_kernels.decoder_azimuths(az_blocks, self.dual) if jit.ENABLED
-                         else hdl32e.decoder_azimuths_centideg(az_blocks, dual=self.dual))
-            firing_az = firing_az[:, ::2] if self.dual else firing_az
-            seed = self.world.scenario.seed
-            self.noise_rng = chunk_stream(seed, "lidar.range_noise", index)
-            self.weather_rng = chunk_stream(seed, "lidar.weather", index)
-            with single_blas_thread():  # the chunk's matrix products are small (raysim.sensors.blas_threads)
-                fire = self.measure(t, block_az, firing_az.reshape(-1, hdl32e.N_LASERS))
-            payloads = self.packets(fire)
-            sent = t[:: self.cycles_per_packet] + self.cycles_per_packet * hdl32e.CYCLE_DT_S
-            # position packets due within this chunk go in time order with the data packets
-            t_end = t[-1] + hdl32e.CYCLE_DT_S
-            position_times = []
-            while self.cfg.position_packet_rate_hz > 0 and next_position_s < t_end:
-                position_times.append(next_position_s)
-                next_position_s += 1.0 / self.cfg.position_packet_rate_hz
-            yield LidarChunk(t, fire, payloads, sent, position_times)
-            self.chunk_wall_s.append((t_end - t[0], time.perf_counter() - chunk_started))
+        seed = self.world.scenario.seed
+        # a chunk's cast runs on a second thread while the chunk before it is measured (no random draws in it)
+        with ThreadPoolExecutor(1, thread_name_prefix="lidar-cast") as caster, single_blas_thread():
+            started, ahead = time.perf_counter(), None
+            for index in (progress(indices) if progress else indices):
+                if claim is not None and not claim(index):
+                    break
+                t, block_az, firing_az = self._chunk_firings(index)
+                cast = caster.submit(self._cast_stage, t, firing_az)
+                if ahead is not None:
+                    chunk, next_position_s = self._finish_chunk(*ahead, seed, next_position_s)
+                    yield chunk
+                    started = self._timed(chunk, started)
+                ahead = (index, block_az, cast)
+            if ahead is not None:
+                chunk, next_position_s = self._finish_chunk(*ahead, seed, next_position_s)
+                yield chunk
+                self._timed(chunk, started)
+
+    def _chunk_firings(self, index: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Chunk ``index``'s cycle start times (C,) s, block azimuths (C,) and firing azimuths (C, 32), 0.01 deg."""
+        first_packet = index * self.chunk_packets
+        packets_here = min(self.chunk_packets, self.n_packets - first_packet)
+        k0 = first_packet * self.cycles_per_packet
+        t = (k0 + np.arange(packets_here * self.cycles_per_packet)) * hdl32e.CYCLE_DT_S
+        block_az = hdl32e.block_azimuth_centideg(t, self.cfg.rotation_hz, self.cfg.azimuth0_deg)
+        az_blocks = (np.repeat(block_az, DUAL_RETURNS) if self.dual else block_az).reshape(-1, hdl32e.BLOCKS_PER_PACKET)
+        firing_az = (lidar_kernels.decoder_azimuths(az_blocks, self.dual) if jit.ENABLED
+                     else hdl32e.decoder_azimuths_centideg(az_blocks, dual=self.dual))
+        firing_az = firing_az[:, ::2] if self.dual else firing_az
+        return t, block_az, firing_az.reshape(-1, hdl32e.N_LASERS)
+
+    def _finish_chunk(self, index: int, block_az: np.ndarray, cast, seed: int,
+                      next_position_s: float) -> tuple[LidarChunk, float]:
+        """Chunk ``index`` measured from its cast (a future) with its own random streams, its packets encoded;
+        and the time of the next position packet, s."""
+        self.noise_rng = chunk_stream(seed, "lidar.range_noise", index)
+        self.weather_rng = chunk_stream(seed, "lidar.weather", index)
+        fire = self._echo_stage(cast.result(), block_az)
+        t = fire.cycle_time_s
+        payloads = self.packets(fire)
+        sent = t[:: self.cycles_per_packet] + self.cycles_per_packet * hdl32e.CYCLE_DT_S
+        # position packets due within this chunk go in time order with the data packets
+        t_end = t[-1] + hdl32e.CYCLE_DT_S
+        position_times = []
+        while self.cfg.position_packet_rate_hz > 0 and next_position_s < t_end:
+            position_times.append(next_position_s)
+            next_position_s += 1.0 / self.cfg.position_packet_rate_hz
+        return LidarChunk(t, fire, payloads, sent, position_times), next_position_s
+
+    def _timed(self, chunk: LidarChunk, started: float) -> float:
+        """Record the chunk's scenario span and the wall time since the last chunk was handed on; returns now."""
+        now = time.perf_counter()
+        t = chunk.time_s
+        self.chunk_wall_s.append((t[-1] + hdl32e.CYCLE_DT_S - t[0], now - started))
+        return now
 
     def _positions_before(self, first: int) -> tuple[float, int]:
         """The time of the first position packet of chunk ``first``, s (summed as the chunks before it sum

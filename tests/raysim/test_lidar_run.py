@@ -160,3 +160,44 @@ def test_the_writer_thread_changes_no_byte(whole, tmp_path, monkeypatch):
     out, counts = whole
     assert render_chunks(_renderer(1.05), tmp_path) == counts
     assert _digests(tmp_path / "lidar") == _digests(out / "lidar")
+
+
+# ------------------------------------------------------------------ the cast on a second thread
+
+
+def test_chunks_cast_ahead_are_the_chunks_measured_one_by_one():
+    """chunks() casts a chunk while it measures the one before: the same firings as measure() chunk by chunk."""
+    from raysim.random_streams import chunk_stream
+
+    piped, plain = _renderer(0.55), _renderer(0.55)
+    seed = plain.world.scenario.seed
+    chunks = list(piped.chunks())
+    assert len(chunks) == plain.n_chunks == 6 and len(piped.chunk_wall_s) == 6
+    for index, chunk in enumerate(chunks):
+        t, block_az, firing_az = plain._chunk_firings(index)
+        plain.noise_rng = chunk_stream(seed, "lidar.range_noise", index)
+        plain.weather_rng = chunk_stream(seed, "lidar.weather", index)
+        fire = plain.measure(t, block_az, firing_az)
+        assert np.array_equal(chunk.time_s, t)
+        for name in ("distance_units", "reflectivity", "object_id", "source"):
+            assert np.array_equal(getattr(chunk.firings, name), getattr(fire, name)), name
+        assert chunk.payloads.tobytes() == plain.packets(fire).tobytes()
+
+
+def test_a_fault_in_the_cast_ahead_reaches_the_render(monkeypatch):
+    renderer = _renderer(0.55)
+    cast_stage = renderer._cast_stage
+    calls = []
+
+    def failing(t, firing_az):
+        calls.append(t[0])
+        if len(calls) == 3:
+            raise MemoryError("cast 3")
+        return cast_stage(t, firing_az)
+
+    monkeypatch.setattr(renderer, "_cast_stage", failing)
+    seen = []
+    with pytest.raises(MemoryError, match="cast 3"):
+        for chunk in renderer.chunks():
+            seen.append(chunk)
+    assert len(seen) == 2  # the chunks before the failed cast, and nothing after it
