@@ -244,7 +244,8 @@ class LidarRenderer(LidarGeometry):
         cand.byte[:, 0][own] = np.take(t["byte"], key_own)
         cand.object_id[:, 0][own] = t["object_id"]
         free = np.flatnonzero(~on_own)
-        cast = _Rays(np.take(rays.origins_m, free, axis=0), np.take(rays.directions, free, axis=0), np.take(rays.times_s, free))
+        cast = _Rays(np.take(rays.origins_m, free, axis=0), np.take(rays.directions, free, axis=0),
+                     np.take(rays.times_s, free))
         return self._cast(cast), free, cast, None
 
     def _cast_with_own_ship(self, rays: _Rays, origins_s: np.ndarray, directions_s: np.ndarray):

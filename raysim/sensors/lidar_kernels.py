@@ -106,7 +106,8 @@ def _rays_past_own_ship(firing_az, cos_el, sin_el, cos_az, sin_az, z_offset_m, a
 
 
 def rays_past_own_ship(firing_az: np.ndarray, beams: tuple, a0: np.ndarray, da: np.ndarray, frac: np.ndarray,
-                       firing_times_s: np.ndarray, table: dict, cand) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+                       firing_times_s: np.ndarray, table: dict,
+                       cand) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Each firing's world ray (:func:`_ray`), answered from the own-ship beam table or gathered to be cast.
 
     :meth:`raysim.sensors.lidar.LidarRenderer._cast_past_own_ship`'s lookups fused with the world rays in one
