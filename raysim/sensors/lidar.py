@@ -460,6 +460,12 @@ class LidarRenderer(LidarGeometry):
         (:func:`raysim.random_streams.chunk_stream`), so a chunk's bytes do not depend on which
         chunks were rendered before it, nor in which process.
 
+        A chunk's cast (:meth:`_cast_stage`, no random draws) runs on a second thread while the chunk
+        before it is measured (:meth:`_echo_stage`), so a chunk is claimed and cast one chunk ahead of
+        the one yielded. numpy's BLAS stays at one thread while the generator lives (the chunks'
+        matrix products are small: :mod:`raysim.sensors.blas_threads`). ``chunk_wall_s`` gets each
+        chunk's wall time from the hand-on of the one before.
+
         Parameters
         ----------
         progress : callable, optional
