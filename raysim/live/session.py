@@ -80,7 +80,8 @@ def _streams(world: World, scene_factory, ports: LivePorts, stop, working: Path 
         lidar = LidarRenderer(world, scene_factory())  # the position packets only read the own ship's pose
         done["lidar"] = threading.Event()
         sweeps = working / "lidar" / "sweeps" if working is not None else None
-        out.append(("lidar", (ports.dest, ports.lidar), lidar_data_batches(lidar, sweeps, done["lidar"])))
+        out.append(("lidar", (ports.dest, ports.lidar),
+                    lidar_data_batches(lidar, sweeps, done["lidar"], cast_ahead=fed is None)))
         if ports.lidar_position:
             out.append(("lidar_position", (ports.dest, ports.lidar_position), lidar_position_batches(lidar)))
     if "radar" in enabled and (ports.radar or working is not None):

@@ -53,18 +53,19 @@ class Batch:
         return float(self.times_s[-1]) if len(self.payloads) else -np.inf
 
 
-def lidar_data_batches(renderer, sweeps_dir: Path | None = None, done: threading.Event | None = None
-                       ) -> Iterator[Batch]:
+def lidar_data_batches(renderer, sweeps_dir: Path | None = None, done: threading.Event | None = None,
+                       cast_ahead: bool = True) -> Iterator[Batch]:
     """The HDL-32E's 1206-byte data packets, a chunk (about one revolution) a batch, each at its send time.
 
     With ``sweeps_dir`` the revolutions' sweep files are written there too (the live TDM reads them);
-    ``done`` is set once the last one is written.
+    ``done`` is set once the last one is written. ``cast_ahead``: as in ``LidarRenderer.chunks`` (off for a
+    fed own ship, whose pose is not to be extrapolated a chunk further).
     """
     from raysim.sensors.lidar_sweeps import LidarSweeps
 
     sweeps = LidarSweeps(renderer, sweeps_dir) if sweeps_dir is not None else None
     try:
-        for chunk in renderer.chunks():
+        for chunk in renderer.chunks(cast_ahead=cast_ahead):
             if sweeps is not None:
                 sweeps.add(chunk)
             yield Batch(chunk.sent_s, [bytes(p) for p in chunk.payloads])

@@ -453,7 +453,7 @@ class LidarRenderer(LidarGeometry):
         """Start of chunk ``index`` (``n_chunks``: the end of the run), s."""
         return min(index * self.chunk_packets, self.n_packets) * self.cycles_per_packet * hdl32e.CYCLE_DT_S
 
-    def chunks(self, progress=None, first: int = 0, end: int | None = None, claim=None):
+    def chunks(self, progress=None, first: int = 0, end: int | None = None, claim=None, cast_ahead: bool = True):
         """Render chunks ``first .. end - 1`` (about one revolution each; all by default) in time order.
 
         Each chunk draws its range noise and weather from its own random streams
@@ -462,7 +462,7 @@ class LidarRenderer(LidarGeometry):
 
         A chunk's cast (:meth:`_cast_stage`, no random draws) runs on a second thread while the chunk
         before it is measured (:meth:`_echo_stage`), so a chunk is claimed and cast one chunk ahead of
-        the one yielded. numpy's BLAS stays at one thread while the generator lives (the chunks'
+        the one yielded (``cast_ahead`` False: each chunk cast when it is due, the same bytes). numpy's BLAS stays at one thread while the generator lives (the chunks'
         matrix products are small: :mod:`raysim.sensors.blas_threads`). ``chunk_wall_s`` gets each
         chunk's wall time from the hand-on of the one before.
 
@@ -475,6 +475,9 @@ class LidarRenderer(LidarGeometry):
         claim : callable, optional
             ``claim(index) -> bool``, asked before each chunk: False stops the render there
             (:class:`raysim.sensors.lidar_run.ChunkClaims`, two processes sharing a run).
+        cast_ahead : bool
+            Cast the next chunk while this one is measured (live mode with a fed own ship: not, so that
+            no chunk is cast from a pose further ahead of the clock than the one it is due at).
 
         Yields
         ------
@@ -485,13 +488,19 @@ class LidarRenderer(LidarGeometry):
         indices = range(first, self.n_chunks if end is None else min(end, self.n_chunks))
         seed = self.world.scenario.seed
         # a chunk's cast runs on a second thread while the chunk before it is measured (no random draws in it)
-        with ThreadPoolExecutor(1, thread_name_prefix="lidar-cast") as caster, single_blas_thread():
+        # (BLAS outermost: its thread count is restored only after the cast thread has stopped)
+        with single_blas_thread(), ThreadPoolExecutor(1, thread_name_prefix="lidar-cast") as caster:
             started, ahead = time.perf_counter(), None
             for index in (progress(indices) if progress else indices):
                 if claim is not None and not claim(index):
                     break
                 t, block_az, firing_az = self._chunk_firings(index)
                 cast = caster.submit(self._cast_stage, t, firing_az)
+                if not cast_ahead:  # measured and handed on before the next chunk is claimed or cast
+                    chunk, next_position_s = self._finish_chunk(index, block_az, cast, seed, next_position_s)
+                    yield chunk
+                    started = self._timed(chunk, started)
+                    continue
                 if ahead is not None:
                     chunk, next_position_s = self._finish_chunk(*ahead, seed, next_position_s)
                     yield chunk

@@ -42,7 +42,8 @@ def render_chunks(renderer, out_dir: Path, progress=None, first: int = 0, end: i
     and starts at or after the first chunk's revolution. ``claim``: as in ``chunks``.
 
     A chunk's files are written on a writer thread while the next chunk renders (:class:`ChunkWriter`):
-    the ray engine and the compiled kernels release the GIL, so the two overlap on a second core.
+    the compiled kernels, numpy's loops over large arrays and the files' system calls release the GIL
+    (Open3D's cast does not), so the two overlap on a second core.
     """
     from raysim.sensors.lidar_sweeps import LidarSweeps
 
@@ -89,12 +90,23 @@ class ChunkWriter:
         self.write = write
         self._pool = ThreadPoolExecutor(1, thread_name_prefix="lidar-writer")
         self._pending: deque[Future] = deque()
+        self._failed = False
 
     def put(self, chunk) -> None:
         """Hand ``chunk`` to the writer (after waiting for the oldest, if too many are pending)."""
         while len(self._pending) >= CHUNKS_IN_FLIGHT:
             self._pending.popleft().result()
-        self._pending.append(self._pool.submit(self.write, chunk))
+        self._pending.append(self._pool.submit(self._write_unless_failed, chunk))
+
+    def _write_unless_failed(self, chunk) -> None:
+        """On the writer thread: after a fault, the chunks queued behind it are not written."""
+        if self._failed:
+            return
+        try:
+            self.write(chunk)
+        except BaseException:
+            self._failed = True
+            raise
 
     def __enter__(self) -> "ChunkWriter":
         return self

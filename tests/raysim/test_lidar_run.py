@@ -201,3 +201,45 @@ def test_a_fault_in_the_cast_ahead_reaches_the_render(monkeypatch):
         for chunk in renderer.chunks():
             seen.append(chunk)
     assert len(seen) == 2  # the chunks before the failed cast, and nothing after it
+
+
+def test_chunks_without_the_cast_ahead_are_the_same_and_cast_only_when_due(monkeypatch):
+    """cast_ahead=False (live mode with a fed own ship): the same chunks, and no chunk is cast before the one
+    before it has been handed on."""
+    piped, due = _renderer(0.35), _renderer(0.35)
+    events = []
+    cast_stage = due._cast_stage
+
+    def logged(t, firing_az):
+        events.append(("cast", round(float(t[0]), 6)))
+        return cast_stage(t, firing_az)
+
+    monkeypatch.setattr(due, "_cast_stage", logged)
+    got = []
+    for chunk in due.chunks(cast_ahead=False):
+        events.append(("yield", round(float(chunk.time_s[0]), 6)))
+        got.append(chunk)
+    assert [e[0] for e in events] == ["cast", "yield"] * len(got) and len(got) == 4
+    for a, b in zip(piped.chunks(), got):
+        assert a.payloads.tobytes() == b.payloads.tobytes()
+
+
+def test_after_a_writer_fault_the_chunks_behind_it_are_not_written():
+    import threading
+
+    written, gate = [], threading.Event()
+
+    def write(chunk):
+        gate.wait(5)
+        if chunk == 1:
+            raise OSError(28, "No space left on device")
+        written.append(chunk)
+
+    with pytest.raises(OSError):
+        with ChunkWriter(write) as writer:
+            writer.put(0)
+            writer.put(1)
+            gate.set()
+            for i in range(2, 6):
+                writer.put(i)
+    assert written == [0]
