@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import datetime as dt
 import time
+from collections import deque
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
@@ -35,7 +36,7 @@ from raysim.sensors import lidar_physics as phys
 from raysim.sensors.blas_threads import single_blas_thread
 from raysim.sensors.carrier import CarrierScene
 from raysim.sensors.context import SensorContext
-from raysim.sensors.lidar_rays import CAST_RANGE_MARGIN_M, LidarGeometry
+from raysim.sensors.lidar_rays import CAST_RANGE_MARGIN_M, LidarGeometry, _Rays
 from raysim.world import World
 
 SOURCE_OBJECT, SOURCE_SEA, SOURCE_WEATHER = 0, 1, 2
@@ -73,15 +74,6 @@ class Firings:
     reflectivity: np.ndarray
     object_id: np.ndarray
     source: np.ndarray
-
-
-@dataclass
-class _Rays:
-    """A chunk's N = F K rays in the world: origins (N, 3) m, unit directions (N, 3), firing times (N,) s."""
-
-    origins_m: np.ndarray
-    directions: np.ndarray
-    times_s: np.ndarray
 
 
 @dataclass
@@ -462,8 +454,9 @@ class LidarRenderer(LidarGeometry):
 
         A chunk's cast (:meth:`_cast_stage`, no random draws) runs on a second thread while the chunk
         before it is measured (:meth:`_echo_stage`), so a chunk is claimed and cast one chunk ahead of
-        the one yielded (``cast_ahead`` False: each chunk cast when it is due, the same bytes). numpy's BLAS stays at one thread while the generator lives (the chunks'
-        matrix products are small: :mod:`raysim.sensors.blas_threads`). ``chunk_wall_s`` gets each
+        the one yielded (``cast_ahead`` False: each chunk cast when it is due, the same bytes). numpy's
+        BLAS stays at one thread while the generator lives (the chunks' matrix products are small:
+        :mod:`raysim.sensors.blas_threads`). ``chunk_wall_s`` gets each
         chunk's wall time from the hand-on of the one before.
 
         Parameters
@@ -486,30 +479,24 @@ class LidarRenderer(LidarGeometry):
         """
         next_position_s = self._positions_before(first)[0]
         indices = range(first, self.n_chunks if end is None else min(end, self.n_chunks))
-        seed = self.world.scenario.seed
-        # a chunk's cast runs on a second thread while the chunk before it is measured (no random draws in it)
+        lead = 1 if cast_ahead else 0  # chunks cast before the oldest cast one is measured and handed on
+        casts: deque = deque()
         # (BLAS outermost: its thread count is restored only after the cast thread has stopped)
         with single_blas_thread(), ThreadPoolExecutor(1, thread_name_prefix="lidar-cast") as caster:
-            started, ahead = time.perf_counter(), None
+            started = time.perf_counter()
             for index in (progress(indices) if progress else indices):
                 if claim is not None and not claim(index):
                     break
                 t, block_az, firing_az = self._chunk_firings(index)
-                cast = caster.submit(self._cast_stage, t, firing_az)
-                if not cast_ahead:  # measured and handed on before the next chunk is claimed or cast
-                    chunk, next_position_s = self._finish_chunk(index, block_az, cast, seed, next_position_s)
+                casts.append((index, block_az, caster.submit(self._cast_stage, t, firing_az)))
+                if len(casts) > lead:
+                    chunk, next_position_s = self._finish_chunk(*casts.popleft(), next_position_s)
                     yield chunk
                     started = self._timed(chunk, started)
-                    continue
-                if ahead is not None:
-                    chunk, next_position_s = self._finish_chunk(*ahead, seed, next_position_s)
-                    yield chunk
-                    started = self._timed(chunk, started)
-                ahead = (index, block_az, cast)
-            if ahead is not None:
-                chunk, next_position_s = self._finish_chunk(*ahead, seed, next_position_s)
+            while casts:  # the chunks cast ahead of the last one claimed
+                chunk, next_position_s = self._finish_chunk(*casts.popleft(), next_position_s)
                 yield chunk
-                self._timed(chunk, started)
+                started = self._timed(chunk, started)
 
     def _chunk_firings(self, index: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Chunk ``index``'s cycle start times (C,) s, block azimuths (C,) and firing azimuths (C, 32), 0.01 deg."""
@@ -524,10 +511,10 @@ class LidarRenderer(LidarGeometry):
         firing_az = firing_az[:, ::2] if self.dual else firing_az
         return t, block_az, firing_az.reshape(-1, hdl32e.N_LASERS)
 
-    def _finish_chunk(self, index: int, block_az: np.ndarray, cast, seed: int,
-                      next_position_s: float) -> tuple[LidarChunk, float]:
+    def _finish_chunk(self, index: int, block_az: np.ndarray, cast, next_position_s: float) -> tuple[LidarChunk, float]:
         """Chunk ``index`` measured from its cast (a future) with its own random streams, its packets encoded;
         and the time of the next position packet, s."""
+        seed = self.world.scenario.seed
         self.noise_rng = chunk_stream(seed, "lidar.range_noise", index)
         self.weather_rng = chunk_stream(seed, "lidar.weather", index)
         fire = self._echo_stage(cast.result(), block_az)

@@ -9,6 +9,8 @@ sub-rays through numpy.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from groundfloor import hdl32e
@@ -41,6 +43,15 @@ def _add_scaled(total: np.ndarray, change: np.ndarray, scale: np.ndarray) -> Non
     flat_total.shape = flat.shape = (total.shape[0], -1)  # views (an error, never a silent copy)
     np.multiply(flat, scale, out=flat)
     np.add(flat_total, flat, out=flat_total)
+
+
+@dataclass
+class _Rays:
+    """A chunk's N = F K rays in the world: origins (N, 3) m, unit directions (N, 3), firing times (N,) s."""
+
+    origins_m: np.ndarray
+    directions: np.ndarray
+    times_s: np.ndarray
 
 
 class LidarGeometry:
@@ -161,8 +172,6 @@ class LidarGeometry:
         Returns the (M,) indices of the rays to cast and those rays (a ``_Rays`` of (M, 3) origins, m,
         unit directions and (M,) times, s).
         """
-        from raysim.sensors.lidar import _Rays
-
         a0, da = self._cycle_maps(cycle_time_s)
         beams = (hdl32e.COS_ELEVATION, hdl32e.SIN_ELEVATION, hdl32e.COS_AZIMUTH_STEP, hdl32e.SIN_AZIMUTH_STEP,
                  hdl32e.beam_origins()[:, 2])

@@ -51,25 +51,27 @@ def render_chunks(renderer, out_dir: Path, progress=None, first: int = 0, end: i
     start_s = renderer.chunk_start_s(first)
     # from the revolution under way at the first chunk: its first points are in the chunk before
     sweeps = LidarSweeps(renderer, lidar_dir / "sweeps", from_s=start_s)
-    counts = {"packets": 0, "position_packets": 0, "chunks": 0}
+    counts = {"packets": 0, "position_packets": 0}
+    last = first  # the chunk after the last one written
     path = lidar_dir / (PCAP_NAME if first == 0 else f"{PART_PREFIX}{first:06d}")
     frames_before = first * renderer.chunk_packets + renderer._positions_before(first)[1]
     with atomic_path(path) as tmp, open(tmp, "wb") as handle:
         pcap = PcapWriter(handle, header=first == 0, frames_before=frames_before)
 
         def write(chunk) -> None:  # on the writer thread, one chunk after another in order
+            nonlocal last
             sweeps.add(chunk)
             if chunk.time_s[0] < start_s:  # the chunk before the part: its sweep points only
                 return
             renderer._write_in_order(pcap, chunk.payloads, chunk.sent_s, chunk.position_times_s)
             counts["packets"] += chunk.payloads.shape[0]
             counts["position_packets"] += len(chunk.position_times_s)
-            counts["chunks"] += 1
+            last += 1
 
         with ChunkWriter(write) as writer:
             for chunk in renderer.chunks(progress, first=max(first - 1, 0), end=end, claim=claim):
                 writer.put(chunk)
-        sweeps.finish(renderer.chunk_start_s(first + counts.pop("chunks")))
+        sweeps.finish(renderer.chunk_start_s(last))
     return {**counts, **sweeps.counts}
 
 
