@@ -103,7 +103,7 @@ def _frontend_chunk(jobs: list[tuple[str, object]]) -> list[FrontendResult]:
             lidar.append((k, sweep, path))
         else:
             mount, cfg = _WORKER["radar"]
-            dets = drop_sidelobes(radar_detections(sweep, track, mount, cfg), track, mount, cfg)
+            dets = drop_sidelobes(radar_detections(sweep, track, mount, cfg, land), track, mount, cfg)
             results[k] = _finished("radar", sweep, dets, path)
     if lidar:
         mount, cfg = _WORKER["lidar"]

@@ -88,10 +88,12 @@ from tdm.detections import Detections
 from tdm.frames import Mount, OwnshipTrack
 from tdm.frontend.radar_cfar import (VIDEO_LEVELS, _cfar_cells, _first_valid_sample, _lowest_candidate_level, _nonzero_flat,
                                      cfar_mask, training_table, video_power, video_power_table)
-from tdm.frontend.radar_clutter import (_group_sums, _margin_over_clutter_db, _windows, beam_integrated_power, clutter_map,
-                                       integration_group)
+from tdm.frontend.radar_clutter import (LandBlocks, _group_sums, _margin_over_clutter_db, _windows, beam_integrated_power,
+                                       clutter_map, integration_group)
 from tdm.frontend.radar_config import RadarFrontEndConfig, ca_alpha, mount_from_scenario, os_alpha
+from tdm.frontend.radar_land import land_blocks
 from tdm.frontend.radar_plots import _runs, fill_gaps, label_plots
+from tdm.land import LandMask
 
 __all__ = ["RadarFrontEndConfig", "beam_integrated_power", "ca_alpha", "cfar_mask", "clutter_map", "fill_gaps",
            "label_plots", "mount_from_scenario", "os_alpha", "radar_detections", "training_table", "video_power",
@@ -233,11 +235,13 @@ class _Plots:
     margin_db: np.ndarray
 
 
-def _kept_plots(echo: np.ndarray, range_m: np.ndarray, config: RadarFrontEndConfig) -> _Plots | None:
+def _kept_plots(echo: np.ndarray, range_m: np.ndarray, config: RadarFrontEndConfig,
+                land: LandBlocks | None = None) -> _Plots | None:
     """The plots that pass the size, spoke and clutter tests (module docstring, steps 1-6), or None.
 
     Counts and tests run on the plots' runs along range (:func:`_label_runs`); only the cells of the
-    plots that pass the size and spoke tests are spelt out for the clutter test.
+    plots that pass the size and spoke tests are spelt out for the clutter test. ``land``: the
+    clutter map's land blocks, left out of the clutter level (:mod:`tdm.frontend.radar_land`).
     """
     n_spokes, n_samples = echo.shape
     flat, integrated, g = _plot_cells(echo, range_m, config)
@@ -251,7 +255,7 @@ def _kept_plots(echo: np.ndarray, range_m: np.ndarray, config: RadarFrontEndConf
     keep &= _spokes_per_label(runs.label[sized], runs.spoke[sized], runs.n + 1, n_spokes) >= config.min_plot_spokes
     pos, lab, spoke = _run_cells(runs, np.flatnonzero(keep[runs.label]))
     sample = flat[pos] - spoke * n_samples
-    margin_db = _margin_over_clutter_db(lab, spoke, sample, runs.n + 1, keep, integrated, g, config)
+    margin_db = _margin_over_clutter_db(lab, spoke, sample, runs.n + 1, keep, integrated, g, config, land)
     keep &= margin_db >= config.clutter_margin_db
     if not keep.any():
         return None
@@ -425,7 +429,8 @@ def _plot_covariance(plot_range_m: np.ndarray, u: np.ndarray, len_r_m: np.ndarra
     return var_r[:, None, None] * u[:, :, None] * u[:, None, :] + var_c[:, None, None] * c[:, :, None] * c[:, None, :]
 
 
-def radar_detections(sweep: dict, track: OwnshipTrack, mount: Mount, config: RadarFrontEndConfig) -> Detections:
+def radar_detections(sweep: dict, track: OwnshipTrack, mount: Mount, config: RadarFrontEndConfig,
+                     land: LandMask | None = None) -> Detections:
     """Plots of one radar sweep in the TDM's ENU frame.
 
     Parameters
@@ -439,6 +444,10 @@ def radar_detections(sweep: dict, track: OwnshipTrack, mount: Mount, config: Rad
     mount : Mount
         The radar's mounting on the own ship.
     config : RadarFrontEndConfig
+    land : LandMask, optional
+        The chart's land: its blocks are left out of the clutter map's level when
+        ``config.clutter_map_without_land`` (:mod:`tdm.frontend.radar_land`). The plots on or near it
+        are not dropped here (:func:`tdm.land.drop_on_land` does that).
 
     Returns
     -------
@@ -474,7 +483,13 @@ def radar_detections(sweep: dict, track: OwnshipTrack, mount: Mount, config: Rad
     echo, azimuth_deg, heading_deg, time_s, range_m = _checked_sweep(sweep, config)
     n_spokes, n_samples = echo.shape
     scan_time = float(time_s[0])
-    plots = _kept_plots(echo, range_m, config)
+    land_at = None
+    if land is not None and config.clutter_map_without_land:
+        def land_at(candidates: np.ndarray, spokes_per_block: int, samples_per_block: int,
+                    beam_fraction: float) -> np.ndarray:
+            return land_blocks(land, candidates, spokes_per_block, samples_per_block, azimuth_deg, heading_deg,
+                               time_s, range_m, track, mount, beam_fraction, config.beam_az_deg)
+    plots = _kept_plots(echo, range_m, config, land_at)
     if plots is None:
         return Detections.empty("radar", scan_time)
     power = video_power(echo[plots.spoke, plots.sample], config).astype(np.float64)

@@ -4,13 +4,19 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from functools import lru_cache
 
 import numpy as np
 
 from tdm.frontend.radar_config import RadarFrontEndConfig
 
-__all__ = ["beam_integrated_power", "clutter_map"]
+__all__ = ["LandBlocks", "beam_integrated_power", "clutter_map"]
+
+#: Which clutter-map blocks lie within the beam's smear of the land: called with the (sb, nb) bool blocks to
+#: test, the spokes and the samples per block and the fraction of the beamwidth; returns (sb, nb) bool
+#: (:func:`tdm.frontend.radar_land.land_blocks`, bound to a sweep).
+LandBlocks = Callable[[np.ndarray, int, int, float], np.ndarray]
 
 #: Cells per part of the integration windows' float64 temporaries (they stay in cache).
 _WINDOW_PART_CELLS = 1 << 15
@@ -157,19 +163,26 @@ def _block_max_db(integrated: np.ndarray, group_spokes: int, config: RadarFrontE
     return 10.0 * np.log10(np.maximum(block_max, np.float32(BLOCK_POWER_FLOOR))), ba
 
 
-def _clutter_level_db(block_db: np.ndarray, bi: np.ndarray, bj: np.ndarray, config: RadarFrontEndConfig) -> np.ndarray:
+def _clutter_level_db(block_db: np.ndarray, bi: np.ndarray, bj: np.ndarray, config: RadarFrontEndConfig,
+                      excluded: np.ndarray | None = None) -> np.ndarray:
     """(K,) float32 clutter level (dB) of blocks (bi, bj): the quantile of their annulus's block maxima.
 
     The annulus is read from the block maxima padded by half a window: circular in azimuth, -inf
-    beyond the ends of the range scale (one gather of K x annulus values).
+    beyond the ends of the range scale (one gather of K x annulus values). Blocks marked in
+    ``excluded`` ((sb, nb) bool, the chart's land: :mod:`tdm.frontend.radar_land`) count as outside
+    the annulus too; a block whose annulus is all excluded gets the thermal noise mean, 0 dB.
     """
     sb, nb = block_db.shape
     half_a, half_r = config.clutter_window_blocks[0] // 2, config.clutter_window_blocks[1] // 2
     da, dr = _annulus_offsets(tuple(config.clutter_window_blocks), tuple(config.clutter_guard_blocks))
     width = nb + 2 * half_r
     padded = np.full((sb + 2 * half_a, width), -np.inf, dtype=block_db.dtype)
-    padded[:, half_r:half_r + nb] = block_db[np.arange(-half_a, sb + half_a) % sb]
+    rows = np.arange(-half_a, sb + half_a) % sb
+    padded[:, half_r:half_r + nb] = block_db[rows] if excluded is None else np.where(excluded[rows], -np.inf,
+                                                                                      block_db[rows])
     values = padded.reshape(-1)[(bi * width + bj)[:, None] + ((da + half_a) * width + dr + half_r)[None, :]]
+    if excluded is not None:
+        return _quantile_of_valid_db(values, config)
     n_valid = _annulus_columns_in_range(nb, tuple(config.clutter_window_blocks),
                                         tuple(config.clutter_guard_blocks))[bj]
     # the q-quantile of each block's valid values: rank ceil(q n) among them (-inf sort first)
@@ -185,6 +198,16 @@ def _clutter_level_db(block_db: np.ndarray, bi: np.ndarray, bj: np.ndarray, conf
     return q_db
 
 
+def _quantile_of_valid_db(values: np.ndarray, config: RadarFrontEndConfig) -> np.ndarray:
+    """(K,) float32: per row of ``values`` (K, W) dB, the ``clutter_quantile`` of its finite values
+    (rank ceil(q n) among them), or 0 dB (the thermal noise mean) for a row with none."""
+    n_valid = np.count_nonzero(np.isfinite(values), axis=1)
+    part = np.sort(values, axis=1)  # -inf first
+    rank = values.shape[1] - n_valid + np.maximum(np.ceil(config.clutter_quantile * n_valid).astype(np.int64), 1) - 1
+    q_db = part[np.arange(part.shape[0]), np.minimum(rank, values.shape[1] - 1)]
+    return np.where(n_valid > 0, q_db, np.float32(0.0)).astype(np.float32)
+
+
 @lru_cache(maxsize=8)
 def _annulus_columns_in_range(nb: int, window: tuple[int, int], guard: tuple[int, int]) -> np.ndarray:
     """(nb,) int64: how many of the annulus's blocks lie inside the range scale, per block column."""
@@ -195,13 +218,16 @@ def _annulus_columns_in_range(nb: int, window: tuple[int, int], guard: tuple[int
 
 def _margin_over_clutter_db(lab: np.ndarray, spoke: np.ndarray, sample: np.ndarray, n_labels: int,
                             eligible: np.ndarray, integrated: np.ndarray, g: int,
-                            config: RadarFrontEndConfig) -> np.ndarray:
+                            config: RadarFrontEndConfig, land: LandBlocks | None = None) -> np.ndarray:
     """(n_labels,) float32: each eligible plot's peak beam-integrated power over its clutter level, dB
     (-inf for the others and for plots with no cell above the lowest seed threshold).
 
     A cell of spoke group k lies in integration windows k - 1 and k and takes the larger; a plot's
     peak is its largest, and the clutter level is worked out for the peak's block only
-    (:func:`clutter_map` gives the same threshold for every block).
+    (:func:`clutter_map` gives the same threshold for every block). ``land``, when given, says which
+    blocks are the chart's land: a plot whose peak block lies clear of it (``land_clear_beam_fraction``)
+    is measured against the clutter of the annulus without the land's blocks (``land_beam_fraction``;
+    :mod:`tdm.frontend.radar_land`).
     """
     margin_db = np.full(n_labels, -np.inf, dtype=np.float32)
     a, n_samples = integrated.shape
@@ -228,6 +254,16 @@ def _margin_over_clutter_db(lab: np.ndarray, spoke: np.ndarray, sample: np.ndarr
     block_db, ba = _block_max_db(integrated, g, config)
     block = (row[peak_cell] // ba) * block_db.shape[1] + sample[cells[peak_cell]] // config.clutter_block_samples
     block, plot_block = np.unique(block, return_inverse=True)  # plots sharing a block share its level
-    level_db = _clutter_level_db(block_db, *np.divmod(block, block_db.shape[1]), config)
+    bi, bj = np.divmod(block, block_db.shape[1])
+    level_db = _clutter_level_db(block_db, bi, bj, config)
+    if land is not None:  # blocks clear of the land: their level without the land's blocks
+        clear = np.zeros(block_db.shape, dtype=bool)
+        clear[bi, bj] = True
+        clear[bi, bj] = ~land(clear, ba * g, config.clutter_block_samples, config.land_clear_beam_fraction)[bi, bj]
+        if clear.any():
+            excluded = land(block_db >= config.min_seed_db, ba * g, config.clutter_block_samples,
+                            config.land_beam_fraction)
+            at = np.flatnonzero(clear[bi, bj])
+            level_db[at] = _clutter_level_db(block_db, bi[at], bj[at], config, excluded)
     margin_db[labels] = peak_db - level_db[plot_block]
     return margin_db

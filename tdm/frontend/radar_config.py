@@ -120,6 +120,18 @@ class RadarFrontEndConfig:
         Default 0.5: half the -3 dB beamwidth either side of a coast face, out to where the one-way pattern is
         3 dB (two-way 6 dB) under its peak (a radar's azimuth resolution is its beamwidth); 0 turns it off.
         Not fitted to any scenario: the figure is the beam's.
+    clutter_map_without_land : bool
+        With a chart, a plot clear of the land (``land_clear_beam_fraction``) is measured against the
+        clutter of its annulus without the blocks on the land (grown by the ``land_beam_fraction``
+        smear; :mod:`tdm.frontend.radar_land`): a high quantile of an annulus 183 deg wide takes in the
+        land's echo at the plot's range, which buried a clean echo in busy_port's harbour. Default
+        True; no effect without land. Not fitted: the land is the chart's.
+    land_clear_beam_fraction : float
+        A plot whose peak lies within ``range sin(land_clear_beam_fraction beam_az_deg)`` (plus half a
+        clutter block) of the land keeps the land in its clutter level: it must stand out of the land's
+        own echo, smeared by the beam. Default 1.0, a whole -3 dB beamwidth off the land, where the
+        two-way pattern is 24 dB under its peak (a coast's echo 40 dB over the noise still shows there).
+        Not fitted to a scenario.
     sidelobe_margin_db : float or None
         A plot at least this much weaker (strength over the local clutter) than another of the scan at
         the same range, in its sidelobes, is that plot's sidelobe echo and is dropped
@@ -168,6 +180,8 @@ class RadarFrontEndConfig:
     bearing_sigma_beam_fraction: float = 0.15
     extent_sigma_fraction: float = 0.25
     land_beam_fraction: float = 0.5
+    clutter_map_without_land: bool = True
+    land_clear_beam_fraction: float = 1.0
     sidelobe_margin_db: float | None = 10.0
     sidelobe_range_gate_m: float = 10.0
     sidelobe_offset_deg: tuple[float, float] = (5.2, 60.0)
