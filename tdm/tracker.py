@@ -26,6 +26,7 @@ import numpy as np
 from groundfloor.units import KNOT_MPS
 from tdm import ekf
 from tdm.association import chi2_gate, gnn, mahalanobis2
+from tdm.clutter_areas import ClutterAreas
 from tdm.detections import AisReport, AisStatic, Detections
 
 #: What a strong detection counts towards confirmation (:class:`TrackerConfig` ``strong_from_db``), hits.
@@ -99,6 +100,13 @@ class TrackerConfig:
         A detection whose :attr:`~tdm.detections.Detections.beam_fill` is under this is narrower than an
         echo through the antenna can be (a sea spike): it counts ``weak_hit`` whatever its strength.
         None: not checked (LiDAR).
+    clutter_extra_hits : float
+        In a clutter area (:mod:`tdm.clutter_areas`: a cell of the polar map about the own ship where plots
+        that no track takes gather), a track needs this many hits more than ``confirm_m`` to be
+        confirmed. 0 (default): no map.
+    clutter_cell_range_m, clutter_cell_deg, clutter_memory_scans, clutter_plots_per_scan : float
+        The map's cells (depth m, width deg), its memory (scans) and the free plots a scan that make a cell
+        a clutter area (:class:`tdm.clutter_areas.ClutterAreas`).
     max_speed_mps : float
         A track faster than this (20 m/s = 39 kn: faster than the ships this TDM is for) is
         deleted: it is clutter joined across scans.
@@ -128,6 +136,11 @@ class TrackerConfig:
     strong_from_db: float | None = None
     weak_hit: float = 0.5
     min_beam_fill: float | None = None
+    clutter_extra_hits: float = 0.0
+    clutter_cell_range_m: float = 200.0
+    clutter_cell_deg: float = 30.0
+    clutter_memory_scans: float = 20.0
+    clutter_plots_per_scan: float = 0.3
     max_speed_mps: float = 20.0
     extent_sigma_fraction: float = 0.0
     process: ekf.ProcessNoise = field(default_factory=ekf.ProcessNoise)
@@ -242,6 +255,10 @@ class PositionTracker:
         self.tracks: list[Track] = []
         self._ids = itertools.count(1)
         self._gate = chi2_gate(config.gate_probability, POSITION_DOF)
+        self._clutter = ClutterAreas(config.max_range_m, config.clutter_cell_range_m, config.clutter_cell_deg,
+                                     config.clutter_memory_scans, config.clutter_plots_per_scan) \
+            if config.clutter_extra_hits > 0.0 else None
+        self._own_m = np.zeros(2)
 
     # ---- public -------------------------------------------------------------------------
     def process(self, dets: Detections, ownship_position_m: np.ndarray) -> None:
@@ -272,6 +289,7 @@ class PositionTracker:
             pairs = gnn(cost, self._gate)
         assigned_tracks = {i for i, _ in pairs}
         assigned_dets = {j for _, j in pairs}
+        self._own_m = np.asarray(ownship_position_m, dtype=float)[:2]
         for i, j in pairs:
             self._update(tracks[i], dets, j, cov[j])
         # misses for tracks that could see their object
@@ -285,6 +303,10 @@ class PositionTracker:
             if j not in assigned_dets:
                 self._initiate(dets, j, cov[j])
         self._delete(t_scan)
+        if self._clutter is not None:  # after this scan's decisions: the map holds the scans before
+            free = np.ones(n_det, dtype=bool)
+            free[list(assigned_dets)] = False  # a plot that no track took: clutter, or an object's first
+            self._clutter.update(self._own_m, pos[free])
 
     def confirmed_tracks(self) -> list[Track]:
         return [t for t in self.tracks if t.confirmed]
@@ -294,8 +316,15 @@ class PositionTracker:
         track.hits.append(float(hit))
         while len(track.hits) > self.config.confirm_n:
             track.hits.popleft()
-        if not track.confirmed and sum(track.hits) >= self.config.confirm_m:
+        if not track.confirmed and sum(track.hits) >= self._hits_to_confirm(track):
             track.confirmed = True
+
+    def _hits_to_confirm(self, track: Track) -> float:
+        """``confirm_m``, plus ``clutter_extra_hits`` where the track lies in a clutter area."""
+        cfg = self.config
+        if self._clutter is not None and self._clutter.cluttered(self._own_m, track.x[None, :2])[0]:
+            return cfg.confirm_m + cfg.clutter_extra_hits
+        return float(cfg.confirm_m)
 
     def _measurement(self, dets: Detections, j: int, cov_j: np.ndarray):
         z = np.array([dets.position_m[j, 0], dets.position_m[j, 1], dets.cross_section_m2[j]])
@@ -375,7 +404,7 @@ class PositionTracker:
                 continue
             if not track.confirmed:
                 remaining = cfg.confirm_n - len(track.hits)
-                if sum(track.hits) + STRONG_HIT * remaining < cfg.confirm_m:
+                if sum(track.hits) + STRONG_HIT * remaining < self._hits_to_confirm(track):
                     continue
             keep.append(track)
         # one object seen twice: keep the older confirmed track
