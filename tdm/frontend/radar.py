@@ -445,9 +445,7 @@ def radar_detections(sweep: dict, track: OwnshipTrack, mount: Mount, config: Rad
         The radar's mounting on the own ship.
     config : RadarFrontEndConfig
     land : LandMask, optional
-        The chart's land: its blocks are left out of the clutter map's level when
-        ``config.clutter_map_without_land`` (:mod:`tdm.frontend.radar_land`). The plots on or near it
-        are not dropped here (:func:`tdm.land.drop_on_land` does that).
+        The chart's land, out of the clutter level (:mod:`tdm.frontend.radar_land`); not dropped here.
 
     Returns
     -------
@@ -483,13 +481,8 @@ def radar_detections(sweep: dict, track: OwnshipTrack, mount: Mount, config: Rad
     echo, azimuth_deg, heading_deg, time_s, range_m = _checked_sweep(sweep, config)
     n_spokes, n_samples = echo.shape
     scan_time = float(time_s[0])
-    land_at = None
-    if land is not None and config.clutter_map_without_land:
-        def land_at(candidates: np.ndarray, spokes_per_block: int, samples_per_block: int,
-                    beam_fraction: float) -> np.ndarray:
-            return land_blocks(land, candidates, spokes_per_block, samples_per_block, azimuth_deg, heading_deg,
-                               time_s, range_m, track, mount, beam_fraction, config.beam_az_deg)
-    plots = _kept_plots(echo, range_m, config, land_at)
+    plots = _kept_plots(echo, range_m, config, _sweep_land_blocks(land, azimuth_deg, heading_deg, time_s, range_m,
+                                                                  track, mount, config))
     if plots is None:
         return Detections.empty("radar", scan_time)
     power = video_power(echo[plots.spoke, plots.sample], config).astype(np.float64)
@@ -504,21 +497,27 @@ def radar_detections(sweep: dict, track: OwnshipTrack, mount: Mount, config: Rad
     compass = np.degrees(np.arctan2(u[:, 0], u[:, 1]))
     orientation = np.mod(np.where(len_r >= len_c, compass, compass + 90.0), 180.0)
     return Detections(
-        sensor="radar",
-        scan_time_s=scan_time,
-        time_s=t_plot[k],
-        position_m=position[k],
-        position_cov_m2=cov[k],
-        cross_section_m2=(len_r * len_c)[k],
-        length_m=np.maximum(len_r, len_c)[k],
-        width_m=np.minimum(len_r, len_c)[k],
-        orientation_deg=orientation[k],
+        sensor="radar", scan_time_s=scan_time, time_s=t_plot[k], position_m=position[k], position_cov_m2=cov[k],
+        cross_section_m2=(len_r * len_c)[k], length_m=np.maximum(len_r, len_c)[k],
+        width_m=np.minimum(len_r, len_c)[k], orientation_deg=orientation[k],
         height_m=np.full(int(np.count_nonzero(k)), np.nan),
-        n_cells=np.bincount(plots.label, minlength=plots.n).astype(np.int64)[k],
-        range_m=plot_range_m[k],
-        strength_db=plots.margin_db[k],
-        beam_fill=beam_fill[k],
-    )
+        n_cells=np.bincount(plots.label, minlength=plots.n).astype(np.int64)[k], range_m=plot_range_m[k],
+        strength_db=plots.margin_db[k], beam_fill=beam_fill[k])
+
+
+def _sweep_land_blocks(land: LandMask | None, azimuth_deg: np.ndarray, heading_deg: np.ndarray, time_s: np.ndarray,
+                       range_m: np.ndarray, track: OwnshipTrack, mount: Mount,
+                       config: RadarFrontEndConfig) -> LandBlocks | None:
+    """The clutter map's land test bound to this sweep (:func:`tdm.frontend.radar_land.land_blocks`), or None
+    without a chart or with ``clutter_map_without_land`` off."""
+    if land is None or not config.clutter_map_without_land:
+        return None
+
+    def land_at(candidates: np.ndarray, spokes_per_block: int, samples_per_block: int,
+                beam_fraction: float) -> np.ndarray:
+        return land_blocks(land, candidates, spokes_per_block, samples_per_block, azimuth_deg, heading_deg,
+                           time_s, range_m, track, mount, beam_fraction, config.beam_az_deg)
+    return land_at
 
 
 def _wrap_deg(a):
