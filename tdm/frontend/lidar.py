@@ -414,8 +414,8 @@ def _cluster_cov(fp: _Footprint, los_e: np.ndarray, los_n: np.ndarray, horizonta
                  config: LidarFrontEndConfig) -> np.ndarray:
     """(k, 2, 2) ENU position covariance, m^2: footprint spread + sensor + navigation (module docstring)."""
     k = fp.length_m.shape[0]
-    cov = _axes_cov(fp.phi_long, fp.length_m ** 2 / UNIFORM_VARIANCE_DIVISOR,
-                    fp.width_m ** 2 / UNIFORM_VARIANCE_DIVISOR)
+    cov = config.footprint_variance_scale * _axes_cov(fp.phi_long, fp.length_m ** 2 / UNIFORM_VARIANCE_DIVISOR,
+                                                      fp.width_m ** 2 / UNIFORM_VARIANCE_DIVISOR)
     cross_var = horizontal_range_m ** 2 * (config.azimuth_step_rad ** 2 / UNIFORM_VARIANCE_DIVISOR
                                            + (RAD_PER_MRAD * config.beam_divergence_mrad) ** 2
                                            / DISC_VARIANCE_DIVISOR

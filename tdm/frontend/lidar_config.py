@@ -78,6 +78,15 @@ class LidarFrontEndConfig:
     nav_position_sigma_m : float
         Own-ship position error, 1 sigma per axis, m (GNSS noise and bias; default 0.5 m, a
         typical uncorrected GNSS fix, unverified; :meth:`from_scenario` reads the recording's).
+    footprint_variance_scale : float
+        The cluster's position covariance holds its footprint's spread, ``L^2 / 12`` along its long axis and
+        ``W^2 / 12`` across (a point uniform over the footprint), times this. Default 0.1: the centre from the
+        outline's two extreme points is far better known than a point anywhere on the footprint (the Table 3.2
+        vessel's clusters scatter 1.1-1.3 m about their bias where the footprint term alone says 5-7 m,
+        benchmarks/results/thesis_table32.md), and with the whole spread a LiDAR track of a 25 m ship took
+        20 s to catch up with a wrong first velocity (crossing_silent_ship 34, 13 m behind). Tuned on
+        busy_open_sea seeds 31-35 with the track's ``extent_sigma_fraction`` (1.0, 0.25, 0.1 and 0.03 tried;
+        at 0.1 the median fused error within LiDAR range 2.36-2.60 -> 2.20-2.36 m).
     nav_heading_sigma_deg : float
         Own-ship heading error, 1 sigma, deg (default 0.1 deg, a GNSS compass class,
         unverified; :meth:`from_scenario` reads the recording's).
@@ -131,6 +140,7 @@ class LidarFrontEndConfig:
     rotation_hz: float = 10.0
     beam_divergence_mrad: float = 3.0
     nav_position_sigma_m: float = 0.5
+    footprint_variance_scale: float = 0.1
     nav_heading_sigma_deg: float = 0.1
     centre: Literal["outline", "mean"] = "outline"
     hidden_depth_fraction: float = 0.6
