@@ -140,7 +140,7 @@ class TrackerConfig:
     clutter_cell_range_m: float = 200.0
     clutter_cell_deg: float = 30.0
     clutter_memory_scans: float = 20.0
-    clutter_plots_per_scan: float = 0.3
+    clutter_plots_per_scan: float = 0.1
     max_speed_mps: float = 20.0
     extent_sigma_fraction: float = 0.0
     process: ekf.ProcessNoise = field(default_factory=ekf.ProcessNoise)

@@ -181,14 +181,24 @@ def _clutter_level_db(block_db: np.ndarray, bi: np.ndarray, bj: np.ndarray, conf
     padded[:, half_r:half_r + nb] = block_db[rows] if excluded is None else np.where(excluded[rows], -np.inf,
                                                                                       block_db[rows])
     values = padded.reshape(-1)[(bi * width + bj)[:, None] + ((da + half_a) * width + dr + half_r)[None, :]]
-    if excluded is not None:
-        return _quantile_of_valid_db(values, config)
-    n_valid = _annulus_columns_in_range(nb, tuple(config.clutter_window_blocks),
-                                        tuple(config.clutter_guard_blocks))[bj]
-    # the q-quantile of each block's valid values: rank ceil(q n) among them (-inf sort first)
-    rank = values.shape[1] - n_valid + np.maximum(np.ceil(config.clutter_quantile * n_valid).astype(np.int64), 1) - 1
-    q_db = np.empty(bi.size, dtype=np.float32)
-    full = n_valid == values.shape[1]
+    if excluded is None:
+        n_valid = _annulus_columns_in_range(nb, tuple(config.clutter_window_blocks),
+                                            tuple(config.clutter_guard_blocks))[bj]
+        return _ranked_quantile_db(values, n_valid, config)
+    n_valid = np.count_nonzero(np.isfinite(values), axis=1)
+    q_db = _ranked_quantile_db(values, n_valid, config)
+    q_db[n_valid == 0] = 0.0  # an annulus all land: the thermal noise mean
+    return q_db
+
+
+def _ranked_quantile_db(values: np.ndarray, n_valid: np.ndarray, config: RadarFrontEndConfig) -> np.ndarray:
+    """(K,) float32: per row of ``values`` (K, W) dB, the ``clutter_quantile`` of its ``n_valid`` (K,) valid values,
+    the others -inf: rank ceil(q n) among them (-inf sort first). A row with none gets its largest value."""
+    width = values.shape[1]
+    rank = np.minimum(width - n_valid + np.maximum(np.ceil(config.clutter_quantile * n_valid).astype(np.int64), 1) - 1,
+                      width - 1)
+    q_db = np.empty(values.shape[0], dtype=np.float32)
+    full = n_valid == width
     if full.any():  # one rank for all blocks with a whole annulus: partition
         k = int(rank[full][0])
         q_db[full] = np.partition(values[full], k, axis=1)[:, k]
@@ -196,16 +206,6 @@ def _clutter_level_db(block_db: np.ndarray, bi: np.ndarray, bj: np.ndarray, conf
         part = np.sort(values[~full], axis=1)
         q_db[~full] = part[np.arange(part.shape[0]), rank[~full]]
     return q_db
-
-
-def _quantile_of_valid_db(values: np.ndarray, config: RadarFrontEndConfig) -> np.ndarray:
-    """(K,) float32: per row of ``values`` (K, W) dB, the ``clutter_quantile`` of its finite values
-    (rank ceil(q n) among them), or 0 dB (the thermal noise mean) for a row with none."""
-    n_valid = np.count_nonzero(np.isfinite(values), axis=1)
-    part = np.sort(values, axis=1)  # -inf first
-    rank = values.shape[1] - n_valid + np.maximum(np.ceil(config.clutter_quantile * n_valid).astype(np.int64), 1) - 1
-    q_db = part[np.arange(part.shape[0]), np.minimum(rank, values.shape[1] - 1)]
-    return np.where(n_valid > 0, q_db, np.float32(0.0)).astype(np.float32)
 
 
 @lru_cache(maxsize=8)
@@ -255,15 +255,15 @@ def _margin_over_clutter_db(lab: np.ndarray, spoke: np.ndarray, sample: np.ndarr
     block = (row[peak_cell] // ba) * block_db.shape[1] + sample[cells[peak_cell]] // config.clutter_block_samples
     block, plot_block = np.unique(block, return_inverse=True)  # plots sharing a block share its level
     bi, bj = np.divmod(block, block_db.shape[1])
-    level_db = _clutter_level_db(block_db, bi, bj, config)
-    if land is not None:  # blocks clear of the land: their level without the land's blocks
-        clear = np.zeros(block_db.shape, dtype=bool)
-        clear[bi, bj] = True
-        clear[bi, bj] = ~land(clear, ba * g, config.clutter_block_samples, config.land_clear_beam_fraction)[bi, bj]
-        if clear.any():
-            excluded = land(block_db >= config.min_seed_db, ba * g, config.clutter_block_samples,
-                            config.land_beam_fraction)
-            at = np.flatnonzero(clear[bi, bj])
-            level_db[at] = _clutter_level_db(block_db, bi[at], bj[at], config, excluded)
+    clear = np.zeros(bi.size, dtype=bool)  # peak blocks clear of the land: their level without the land's blocks
+    if land is not None:
+        peaks = np.zeros(block_db.shape, dtype=bool)
+        peaks[bi, bj] = True
+        clear = ~land(peaks, ba * g, config.clutter_block_samples, config.land_clear_beam_fraction)[bi, bj]
+    level_db = np.empty(bi.size, dtype=np.float32)
+    level_db[~clear] = _clutter_level_db(block_db, bi[~clear], bj[~clear], config)
+    if clear.any():
+        excluded = land(block_db >= config.min_seed_db, ba * g, config.clutter_block_samples, config.land_beam_fraction)
+        level_db[clear] = _clutter_level_db(block_db, bi[clear], bj[clear], config, excluded)
     margin_db[labels] = peak_db - level_db[plot_block]
     return margin_db
