@@ -12,6 +12,7 @@ import datetime as dt
 import json
 import multiprocessing
 import platform
+import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -394,6 +395,15 @@ def _manifest(scenario: Scenario, world: World, enabled, rendered: list[str], no
     }
 
 
+def _warn_of_overlaps(world: World) -> None:
+    """One line on stderr for each pair of hulls that pass through one another (:mod:`raysim.world_checks`)."""
+    from raysim.world_checks import hull_overlaps
+
+    source = world.scenario.source_file or "scenario"
+    for overlap in hull_overlaps(world):
+        print(f"warning: {source}: {overlap.message()}", file=sys.stderr, flush=True)
+
+
 def render(scenario: Scenario, out_dir: Path, progress: bool | None = None, formats: tuple[str, ...] = (),
            after_sensors: Callable[[Path], dict[str, int]] | None = None, own_ship_motion=None,
            extra_counts: dict[str, int] | None = None, derived: bool = True,
@@ -439,6 +449,7 @@ def render(scenario: Scenario, out_dir: Path, progress: bool | None = None, form
         if own_ship_motion is not None:
             world.drive_own_ship(own_ship_motion)
         step.done = f"{len(world.objects)} objects"
+    _warn_of_overlaps(world)
     wall["world"] = step.elapsed_s
     enabled = scenario.sensors.enabled_names()
     with StagedDirectory(Path(out_dir)) as staged:
