@@ -124,6 +124,10 @@ class FusionConfig:
     # behind the side seen (Track.extent_var_m2) taken through the fusion's weights as a consider term
     # (fusion_rules.consider_covariance); the fused state and what the fusion weighs are unchanged
     consider_lidar_extent: bool = True
+    # a new radar track that joins no target is absorbed by a target within half the radar's cross-range
+    # resolution (this beamwidth at its range) as well as within the target's footprint: the radar cannot
+    # resolve two echoes within a beamwidth at one range; None: the footprint alone
+    radar_beam_deg: float | None = 5.2
 
 
 @dataclass
@@ -307,8 +311,10 @@ class Fuser:
                 if fi in joined:
                     continue
                 key = (sensor, tr.track_id)
+                unresolved_m = self._unresolved_m(sensor, states[key][0], own_position_m)
                 host = next((t for t in self.targets
-                             if self._inside(states[key], self._estimate(t, states)[0], self._half_length(t, live))), None)
+                             if self._inside(states[key], self._estimate(t, states)[0],
+                                             max(self._half_length(t, live), unresolved_m))), None)
                 if host is not None:
                     host.absorbed.add(key)
                 else:
@@ -330,6 +336,14 @@ class Fuser:
             self._classify(target, x, p, t_s, heights[0] if heights else float("nan"))
             out.append(FusedEstimate(target, x, reported_p, sorted(target.members)))
         return out
+
+    def _unresolved_m(self, sensor: str, x: np.ndarray, own_position_m: np.ndarray | None) -> float:
+        """Half the radar's cross-range resolution at the track's range, m (``radar_beam_deg``); 0 otherwise."""
+        beam_deg = self.config.radar_beam_deg
+        if sensor != "radar" or beam_deg is None or own_position_m is None:
+            return 0.0
+        distance = math.hypot(float(x[0]) - float(own_position_m[0]), float(x[1]) - float(own_position_m[1]))
+        return 0.5 * distance * math.radians(beam_deg)
 
     @staticmethod
     def _with_extent(states: dict, live: dict) -> dict:

@@ -329,3 +329,23 @@ def test_the_lidars_near_side_offset_is_reported_in_the_covariance_not_the_state
     (out,) = fuser.step(0.0, {"lidar": [lidar], "radar": [radar]})
     assert out.x[0] == pytest.approx(4.0 * 0.25 / 1.25)
     assert out.p[0, 0] == pytest.approx(1.0 / 1.25 + (9.0 * 0.8 ** 2 if consider else 0.0))
+
+
+@pytest.mark.parametrize("across_m, own, absorbed", [
+    (22.0, True, True),    # inside half a beamwidth at 600 m (27.2 m), outside the 10 m footprint + 3 sigma (16 m)
+    (35.0, True, False),   # resolved: a new target
+    (22.0, False, False),  # without the own ship's position: the footprint alone
+])
+def test_a_new_radar_track_within_the_beams_resolution_of_a_target_is_absorbed(across_m, own, absorbed):
+    config = FusionConfig()
+    fuser = Fuser(config)
+    own_m = np.array([0.0, 0.0]) if own else None
+    first = make_track(1, "radar", 0.0, 600.0, var=4.0)
+    fuser.step(1.0, {"radar": [first]}, own_m)
+    second = make_track(2, "radar", across_m, 600.0, var=4.0)
+    out = fuser.step(2.0, {"radar": [first, second]}, own_m)
+    assert len(out) == (1 if absorbed else 2)
+    assert 0.5 * 600.0 * np.radians(config.radar_beam_deg) == pytest.approx(27.2, abs=0.05)
+    lidar = make_track(3, "lidar", -across_m, 600.0, var=4.0)  # the rule is the radar's: a LiDAR track is resolved
+    assert len(fuser.step(3.0, {"radar": [first, second], "lidar": [lidar]}, own_m)) == len(out) + 1
+
