@@ -72,7 +72,8 @@ def test_render_warns_in_one_line_per_pair(tmp_path, capsys):
     _warn_of_overlaps(_world(tmp_path, ships))
     err = capsys.readouterr().err.splitlines()
     assert len(err) == 1
-    assert err[0].startswith("warning: ") and "overlap.yaml: ships[0] (tanker) and ships[1] (boat): hulls overlap" in err[0]
+    assert err[0].startswith("warning: ")
+    assert "overlap.yaml: ships[0] (tanker) and ships[1] (boat): hulls overlap" in err[0]
 
 
 def test_the_shipped_scenarios_have_no_hulls_through_one_another():
