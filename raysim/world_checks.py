@@ -20,7 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from raysim.world import World
+from raysim.recording.jsonl import centre_positions_m
+from raysim.world import World, WorldObject
 
 #: time between the instants the check looks at, s: two inscribed discs of 1 m radius between
 #: bodies closing at 4 m/s (8 kn) overlap for at least 0.5 s
@@ -59,18 +60,13 @@ class HullOverlap:
                 f"t = {self.t_s:.1f} s, under the {self.allowed_m:.1f} m their half beams leave)")
 
 
-def _centres_m(world: World, t_s: np.ndarray) -> np.ndarray:
-    """(N, M, 2) east and north of each non-land body's above-water centre at the (N,) times, m."""
+def _centres_m(bodies: list[WorldObject], t_s: np.ndarray) -> np.ndarray:
+    """(N, M, 2) east and north of each body's above-water centre at the (N,) times, m (truth.jsonl's centre)."""
     out = []
-    for o in world.objects:
-        if o.kind == "land":
-            continue
+    for o in bodies:
         poses = o.motion.poses(t_s)
-        c, s = np.cos(poses.yaw_rad), np.sin(poses.yaw_rad)
-        cx, cy = o.centre_body_m
-        out.append(np.stack([poses.position_m[:, 0] + c * cx - s * cy,
-                             poses.position_m[:, 1] + s * cx + c * cy], axis=-1))
-    return np.stack(out, axis=1) if out else np.zeros((t_s.size, 0, 2))
+        out.append(np.stack(centre_positions_m(poses.position_m, poses.yaw_rad, o.centre_body_m), axis=-1))
+    return np.stack(out, axis=1)
 
 
 def hull_overlaps(world: World, step_s: float = STEP_S) -> list[HullOverlap]:
@@ -100,7 +96,7 @@ def hull_overlaps(world: World, step_s: float = STEP_S) -> list[HullOverlap]:
     per_block = max(1, _BLOCK_ELEMENTS // (m * m))
     for start in range(0, t_all.size, _POSE_BLOCK):
         t_block = t_all[start:start + _POSE_BLOCK]
-        centres_block = _centres_m(world, t_block)  # each body posed once per block of instants
+        centres_block = _centres_m(bodies, t_block)  # each body posed once per block of instants
         for first in range(0, t_block.size, per_block):
             t_s = t_block[first:first + per_block]
             centres = centres_block[first:first + per_block]
