@@ -2,7 +2,8 @@
 
 truth.jsonl holds every object every 0.1 s (docs/formats.md); the evaluation needs it only at its
 epochs (1 Hz by default). :func:`read_truth_samples` reads the file line by line, checks every line
-(a mapping; ``t``, ``id``, ``name``, ``kind``, ``lat``, ``lon`` of the right types, numbers finite,
+(a mapping; ``t``, ``id``, ``name``, ``kind``, ``lat``, ``lon`` of the right types, numbers finite, an
+``mmsi`` null or of nine digits at most,
 ``t`` in [0, 1e8] s and in order, one sample per object and time, one own ship, an object's name and
 kind the same on every line), and keeps per object only the samples that bracket a wanted time (the
 last sample at or before it and the first at or after it) plus the object's first and last samples.
@@ -41,15 +42,20 @@ MAX_EPOCHS = 1_000_000
 MAX_EPOCH_OBJECT_CELLS = 10_000_000
 
 _COLUMNS = ("t", "lat", "lon", "cog_deg", "sog_mps")
+#: An object's MMSI when truth.jsonl gives none (it sends no AIS, or the file predates the field).
+NO_MMSI = -1
+#: Largest MMSI (nine digits, ITU-R M.585).
+MAX_MMSI = 999_999_999
 
 
 class _Object:
     """Streaming state of one truth id: its name and kind, its latest sample and whether it is kept."""
 
-    __slots__ = ("name", "kind", "last", "last_kept")
+    __slots__ = ("name", "kind", "mmsi", "last", "last_kept")
 
     def __init__(self, name: str, kind: str):
         self.name, self.kind = name, kind
+        self.mmsi = NO_MMSI
         self.last: tuple = ()
         self.last_kept = True
 
@@ -101,6 +107,16 @@ def _parse_sample(reader: LineReader, row: dict) -> tuple[tuple, str, str]:
     return (t, object_id, lat, lon, cog, sog, ais), name, kind
 
 
+def _mmsi(reader: LineReader, row: dict) -> int:
+    """The line's ``mmsi``: a nine-digit integer, or :data:`NO_MMSI` when absent or null."""
+    value = row.get("mmsi")
+    if value is None:
+        return NO_MMSI
+    if type(value) is int and 0 <= value <= MAX_MMSI:
+        return value
+    raise reader.fail(f"field 'mmsi': {value!r} is not an MMSI (an integer of at most nine digits)"[:200])
+
+
 def _new_object(reader: LineReader, objects: dict, object_id: int, name: str, kind: str) -> _Object:
     if kind == OWNSHIP_KIND:
         own = [i for i, o in objects.items() if o.kind == OWNSHIP_KIND]
@@ -127,7 +143,8 @@ def read_truth_samples(path: Path, keep_t_s: np.ndarray | None = None) -> tuple[
     truth : dict
         Columns of the kept samples (per object in time order): ``t`` (R,) s, ``id`` (R,) int64,
         ``name``, ``kind`` (R,) str, ``lat``, ``lon`` (R,) deg, ``cog_deg``, ``sog_mps`` (R,)
-        (NaN when absent or null), ``ais`` (R,) bool.
+        (NaN when absent or null), ``ais`` (R,) bool, ``mmsi`` (R,) int64 (the object's first
+        ``mmsi`` in the file, :data:`NO_MMSI` when it has none).
     span_s : tuple of float
         Times of the file's first and last lines, s: its span, the times being in order.
 
@@ -167,6 +184,8 @@ def read_truth_samples(path: Path, keep_t_s: np.ndarray | None = None) -> tuple[
                     kept.add(obj.last)
             if keep:
                 kept.add(sample)
+        mmsi = _mmsi(reader, row)
+        obj.mmsi = mmsi if obj.mmsi == NO_MMSI else obj.mmsi
         obj.last, obj.last_kept = sample, keep
     if not objects:
         raise RecordingError(str(path), "(file)", "holds no truth samples")
@@ -186,6 +205,7 @@ def _columns(kept: _Kept, objects: dict) -> dict:
     index = np.searchsorted(ids, out["id"])
     out["name"] = _object_array([objects[int(i)].name for i in ids])[index]
     out["kind"] = _object_array([objects[int(i)].kind for i in ids])[index]
+    out["mmsi"] = np.array([objects[int(i)].mmsi for i in ids], dtype=np.int64)[index]
     return out
 
 
@@ -230,7 +250,7 @@ def read_truth_enu(recording: Path, keep_t_s: np.ndarray | None = None) -> tuple
         Centred on the own ship's first truth position.
     truth : dict of (R,) arrays
         One entry per kept truth line: ``t`` (s), ``id`` (int64), ``name``, ``kind`` (str),
-        ``east_m``, ``north_m`` (m), ``cog_deg``, ``sog_mps``, ``ais`` (bool).
+        ``east_m``, ``north_m`` (m), ``cog_deg``, ``sog_mps``, ``ais`` (bool), ``mmsi`` (int64).
     """
     frame, truth, _ = truth_enu_and_span(recording, keep_t_s)
     return frame, truth
@@ -323,6 +343,8 @@ class TruthAtEpochs:
         Distance from the own ship, metres (NaN where absent).
     own_east_m, own_north_m : (E,) float64
         The own ship's position, metres.
+    mmsi : (K,) int64 or None
+        Each object's MMSI (:data:`NO_MMSI` when it has none); None: not known.
     """
 
     t_s: np.ndarray
@@ -337,6 +359,7 @@ class TruthAtEpochs:
     range_m: np.ndarray
     own_east_m: np.ndarray
     own_north_m: np.ndarray
+    mmsi: np.ndarray | None = None
 
 
 def _nearest_index(t_samples: np.ndarray, t_query: np.ndarray) -> np.ndarray:
@@ -391,5 +414,9 @@ def truth_at(truth: dict[str, np.ndarray], t_s: np.ndarray) -> TruthAtEpochs:
         cols["cog_deg"][present, k] = truth["cog_deg"][near[present]]
         ais[present, k] = truth["ais"][near[present]]
     range_m = np.hypot(cols["east_m"] - own_e[:, None], cols["north_m"] - own_n[:, None])
+    mmsi = None
+    if "mmsi" in truth:
+        mmsi = np.full(K, NO_MMSI, dtype=np.int64)
+        mmsi[np.searchsorted(ids, truth["id"][objects])] = truth["mmsi"][objects]
     return TruthAtEpochs(t_s=t_s, ids=ids, names=names, kinds=kinds, ais=ais, range_m=range_m,
-                         own_east_m=own_e, own_north_m=own_n, **cols)
+                         own_east_m=own_e, own_north_m=own_n, mmsi=mmsi, **cols)

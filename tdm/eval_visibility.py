@@ -23,9 +23,13 @@ from pathlib import Path
 
 import numpy as np
 
+from tdm.detections import ReadStats
 from tdm.errors import RecordingError
 from tdm.eval_params import EvalParams
 from tdm.eval_truth import TruthAtEpochs
+from tdm.frames import EnuFrame
+from tdm.frontend.ais import read_ais
+from tdm.recording.files import is_present, regular_file
 from tdm.recording.npz import ArrayHeader, NpzFile, Unreadable
 from tdm.recording.sweeps import unreadable_warning
 
@@ -42,6 +46,10 @@ RADAR_ARRAYS = {"object_id": ("iu", 1), "object_spokes": ("iu", 1), "time": ("f"
                 "heading_deg": ("f", 1)}
 #: Returned by :func:`load_sweep` for a sweep without the ray-truth arrays.
 NO_RAY_TRUTH = "no ray truth"
+#: An AIS ship is in the AIS's view from each position report received from it until this long after it, s:
+#: the longest nominal reporting interval (ITU-R M.1371-5: class A at anchor or moored, class B at 2 kn or less,
+#: every 3 min; docs/reference.md section 4). Before its first report no AIS receiver knows of it.
+AIS_IN_VIEW_S = 180.0
 def _count(warnings: dict[str, int], what: str) -> None:
     warnings[what] = warnings.get(what, 0) + 1
 
@@ -196,12 +204,54 @@ def _overlaps(starts: np.ndarray, ends: np.ndarray, t_s: np.ndarray, half_window
     return (idx < ends.size) & (starts[np.minimum(idx, ends.size - 1)] <= t_s + half_window_s)
 
 
+def ais_reception_times(recording: Path, frame: EnuFrame, start_time_unix_s: float,
+                        warnings: dict[str, int]) -> dict[int, np.ndarray] | None:
+    """Reception times of each MMSI's position reports in ``ais/ais.nmea`` (s since the start); None without it.
+
+    Read by the TDM's own reader (:func:`tdm.frontend.ais.read_ais`): a line it skips is counted in
+    ``warnings`` as ``tdm run`` counts it, and is not a report received.
+    """
+    path = Path(recording) / "ais" / "ais.nmea"
+    if not is_present(path):
+        return None
+    regular_file(path)
+    stats = ReadStats()
+    reports, _ = read_ais(path, frame, start_time_unix_s, stats)
+    for what, n in stats.warnings.items():
+        warnings[what] = warnings.get(what, 0) + n
+    times: dict[int, list[float]] = {}
+    for report in reports:  # loop over reports: a few per ship a minute
+        times.setdefault(int(report.mmsi), []).append(float(report.time_s))
+    return {mmsi: np.array(t) for mmsi, t in times.items()}
+
+
+def ais_in_view(truth: TruthAtEpochs, received_s: dict[int, np.ndarray]) -> np.ndarray:
+    """(E, K) bool: a position report of the object's MMSI was received within the last :data:`AIS_IN_VIEW_S`.
+
+    Parameters
+    ----------
+    truth : TruthAtEpochs
+        With ``mmsi`` (K,).
+    received_s : dict of int to (M,) float
+        Reception times of each MMSI's position reports, s since the recording's start.
+    """
+    out = np.zeros(truth.range_m.shape, dtype=bool)
+    for k, mmsi in enumerate(truth.mmsi):  # loop over objects
+        times = np.sort(np.asarray(received_s.get(int(mmsi), ()), dtype=float))
+        if times.size:
+            last = np.searchsorted(times, truth.t_s, side="right") - 1  # the last report at or before each epoch
+            out[:, k] = (last >= 0) & (truth.t_s - times[np.maximum(last, 0)] <= AIS_IN_VIEW_S)
+    return out
+
+
 def visibility(recording: Path, params: EvalParams, truth: TruthAtEpochs,
-               warnings: dict[str, int]) -> tuple[dict, dict, dict]:
+               warnings: dict[str, int], ais_received_s: dict[int, np.ndarray] | None = None) -> tuple[dict, dict, dict]:
     """Per rendered sensor, the (E, K) in-range mask; per sensor whose view is ray truth, the (E, K) mask of
     objects within its range but hidden from it (occluded, below the horizon); and the parameters used.
 
-    ``warnings`` receives a count per kind of sweep file cut short (module docstring).
+    ``warnings`` receives a count per kind of sweep file cut short (module docstring). ``ais_received_s``
+    (MMSI -> reception times of its position reports, s; :func:`ais_in_view`): the AIS sees a ship from its
+    first report received; None (no ``ais/ais.nmea``, or truth without MMSIs): from the truth's ``ais`` flag.
     """
     present = np.isfinite(truth.range_m)
     rng = np.where(present, truth.range_m, np.inf)
@@ -218,8 +268,15 @@ def visibility(recording: Path, params: EvalParams, truth: TruthAtEpochs,
                     mask[:, k] = _overlaps(*seen[int(object_id)], truth.t_s, VISIBLE_WINDOW_S)
             hidden["radar"] = visible["radar"] & present & ~mask
             visible["radar"] &= mask
+    ais_mode = None
     if "ais" in params.rendered:
         visible["ais"] = truth.ais & (rng <= params.ais_range_m)
+        ais_mode = "range"
+        if ais_received_s is not None and truth.mmsi is not None:
+            ais_mode = "reports"
+            heard = ais_in_view(truth, ais_received_s)
+            hidden["ais"] = visible["ais"] & present & ~heard
+            visible["ais"] &= heard
     if "lidar" in params.rendered:
         mask = lidar_visible(recording, truth, warnings)
         if mask is None:
@@ -231,5 +288,6 @@ def visibility(recording: Path, params: EvalParams, truth: TruthAtEpochs,
             hidden["lidar"] = (rng <= params.lidar_range_m) & present & ~mask
     used = {"sensors_rendered": list(params.rendered), "radar_range_m": params.radar_range_m,
             "ais_range_m": params.ais_range_m, "lidar_range_max_m": params.lidar_range_m,
-            "lidar_visibility": lidar_mode, "radar_visibility": radar_mode}
+            "lidar_visibility": lidar_mode, "radar_visibility": radar_mode,
+            "ais_visibility": ais_mode, "ais_in_view_s": AIS_IN_VIEW_S}
     return visible, hidden, used

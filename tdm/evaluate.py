@@ -29,7 +29,10 @@ In range (visible)
     later (the next pass); LiDAR: hit by at least one
     LiDAR point whose time is within +-0.5 s of t (``object_id`` of the sweeps; if the
     sweeps carry no ``object_id``: distance <= ``sensors.lidar.range_max_m``); AIS: truth
-    ``ais`` true and distance <= ``sensors.ais.range_m``. A sensor counts when it is in the
+    ``ais`` true, distance <= ``sensors.ais.range_m`` and a position report of the object's
+    MMSI received in ``ais/ais.nmea`` within the last 180 s (``AIS_IN_VIEW_S``, the longest
+    nominal reporting interval of ITU-R M.1371; before its first report no receiver knows of the
+    ship; without the file or truth MMSIs, the flag and distance alone). A sensor counts when it is in the
     manifest's ``sensors_rendered`` (or, without that key, enabled in the scenario). A
     missing radar/AIS range means no range limit. An object becomes visible at the first
     epoch it is in range.
@@ -57,7 +60,8 @@ Detection
     ``detection_latency_max_s`` is over the objects matched at least once.
 Hidden objects ("don't care")
     An object within a sensor's range that the sensor's ray truth says it cannot see
-    (radar sweeps' ``object_id``, LiDAR points' ``object_id``: occluded, below the horizon)
+    (radar sweeps' ``object_id``, LiDAR points' ``object_id``: occluded, below the horizon;
+    for the AIS, a ship none of whose reports has been received for 180 s or yet)
     and that no other sensor sees is neither to be found nor a false alarm: at each epoch
     the reports are assigned (same cost and cut-off) to the in-range and the hidden
     objects together, and those given to hidden objects are ignored (``ignored_reports``),
@@ -122,18 +126,21 @@ from tdm.eval_scoring import sustained_start as _sustained_start
 from tdm.eval_truth import EPOCH_DECIMALS, TRUTH_TIME_TOLERANCE_S, TruthAtEpochs, check_cell_count, \
     check_epoch_count, epoch_grid, epoch_index, read_truth_enu, read_truth_samples, truth_at, truth_enu_and_span, \
     truth_span
-from tdm.eval_visibility import RADAR_VISIBLE_MIN_SPOKES, VISIBLE_WINDOW_S, visibility
+from tdm.eval_visibility import AIS_IN_VIEW_S, RADAR_VISIBLE_MIN_SPOKES, VISIBLE_WINDOW_S, ais_reception_times, \
+    visibility
 from tdm.io import read_manifest, read_scenario
 from tdm.land import on_chart_land
 from tdm.metrics import DEFAULT_CUTOFF_M, DEFAULT_ORDER_P, GOSPA_ALPHA
 from tdm.recording.land import read_land
+from tdm.recording.manifest import start_time_unix_s
 
 __all__ = ["evaluate", "write_metrics", "format_table", "read_truth_enu", "read_reports",
            "TruthAtEpochs", "DEFINITIONS",
            # constants of the modules above, importable from here as before the split
            "DEFAULT_LIDAR_RANGE_M", "DEFAULT_UPDATE_RATE_HZ", "SENSORS", "FULL_PRECISION_DIGITS", "FULL_PRECISION_KEYS",
            "SIGNIFICANT_DIGITS", "DESCRIPTOR_OF_KIND", "MIN_IN_VIEW_S", "NEES_95_INTERVAL", "EPOCH_DECIMALS",
-           "TRUTH_TIME_TOLERANCE_S", "RADAR_VISIBLE_MIN_SPOKES", "VISIBLE_WINDOW_S", "MOVING_SOG_MPS"]
+           "TRUTH_TIME_TOLERANCE_S", "RADAR_VISIBLE_MIN_SPOKES", "VISIBLE_WINDOW_S", "MOVING_SOG_MPS",
+           "AIS_IN_VIEW_S"]
 
 DEFINITIONS = {
     "frame": "ENU metres, transverse Mercator centred on the own ship's first truth position",
@@ -143,8 +150,8 @@ DEFINITIONS = {
                       "own ship excluded",
     "in_range": "radar: distance <= radar range_m and, if the sweeps carry object_id, reached on >= 3 spokes "
                 "of a revolution, seen from the beam's pass over it to the next pass, within +-0.5 s; "
-                "lidar: hit by a LiDAR point within +-0.5 s (object_id); ais: truth ais and distance <= ais range_m; "
-                "any rendered sensor",
+                "lidar: hit by a LiDAR point within +-0.5 s (object_id); ais: truth ais, distance <= ais range_m and a "
+                "position report of its MMSI received within the last 180 s (ais/ais.nmea); any rendered sensor",
     "matching": "per epoch, linear_sum_assignment on min(d, c)^p of targets to in-range truth; pairs with d >= c "
                 "unmatched",
     "ospa_m": "mean over epochs of OSPA (Schuhmacher 2008) on positions, cut-off c, order p",
@@ -191,7 +198,8 @@ def _read_inputs(recording: Path, warnings: dict[str, int]) -> dict:
     targets_path = recording / "tdm" / "detected_targets.jsonl"
     if not targets_path.is_file():
         raise RecordingError(str(targets_path), "(file)", "missing: run `tdm run` first")
-    params = read_params(recording, read_manifest(recording), read_scenario(recording))
+    manifest = read_manifest(recording)
+    params = read_params(recording, manifest, read_scenario(recording))
     targets = read_report_columns(targets_path)
     tracks_path = recording / "tdm" / "sensor_tracks.jsonl"
     tracks = read_report_columns(tracks_path, with_sensor=True) if tracks_path.is_file() else None
@@ -213,7 +221,9 @@ def _read_inputs(recording: Path, warnings: dict[str, int]) -> dict:
     check_cell_count(truth_path, epochs.size, truth_rows)
     truth = truth_at(truth_rows, epochs)
     del truth_rows
-    visible_by_sensor, hidden_by_sensor, used = visibility(recording, params, truth, warnings)
+    ais_received_s = ais_reception_times(recording, frame, start_time_unix_s(manifest, recording), warnings) \
+        if "ais" in params.rendered else None
+    visible_by_sensor, hidden_by_sensor, used = visibility(recording, params, truth, warnings, ais_received_s)
     return {"params": params, "used": used, "frame": frame, "epochs": epochs, "truth": truth,
             "targets": reports_in_frame(targets, frame),
             "tracks": None if tracks is None else reports_in_frame(tracks, frame),

@@ -11,10 +11,14 @@ import numpy as np
 import pytest
 
 from tdm.errors import RecordingError
+from tdm.eval_truth import NO_MMSI, TruthAtEpochs
+from tdm.eval_visibility import ais_in_view
 from tdm.evaluate import _sustained_start, evaluate, format_table, write_metrics
 from tdm.plots import plot_errors, plot_tracks
 
-from .eval_helpers import DURATION_S, _line, _objects, make_recording, save_sweep
+from tdm.frames import EnuFrame
+
+from .eval_helpers import DURATION_S, LAT0, LON0, _line, _objects, make_recording, save_sweep
 
 C = 50.0
 CONTRACT_KEYS = {"ospa_m", "gospa_m", "position_rmse_m", "cog_rmse_deg", "sog_rmse_mps", "detection_rate",
@@ -316,3 +320,46 @@ def test_objects_are_scored_at_their_centre_when_truth_has_it(tmp_path):
     assert np.allclose(truth["east_m"][own], 0.0, atol=1e-6)
     bravo = truth["name"] == "bravo"
     assert np.allclose(truth["east_m"][bravo], 3.0, atol=1e-6)
+
+
+def test_an_ais_ship_comes_into_the_ais_view_with_its_first_report_received(tmp_path):
+    """AIS sees a ship from its first position report in ais/ais.nmea; its targets before that are ignored."""
+    from pyais import encode_dict
+
+    from .test_frontend_ais import START, tagged, type1
+
+    rec = make_recording(tmp_path / "rec")
+    before = evaluate(rec)
+    echo_before = next(o for o in before["per_object"] if o["name"] == "echo")  # 3 km off: the AIS's alone
+    assert before["parameters"]["ais_visibility"] == "range" and echo_before["in_view_from_s"] == 0.0
+    frame = EnuFrame(LAT0, LON0)
+    lat, lon = frame.to_geodetic(0.0, -3000.0)
+    sentence = encode_dict(type1(mmsi=257000005, speed=0.0, lon=float(lon), lat=float(lat)), talker_id="AI",
+                           sentence_type="VDM")[0]
+    (rec / "ais").mkdir()
+    (rec / "ais" / "ais.nmea").write_text(tagged(int(START) + 8, sentence) + "\n", encoding="ascii")
+    m = evaluate(rec)
+    assert m["parameters"]["ais_visibility"] == "reports"
+    echo = next(o for o in m["per_object"] if o["name"] == "echo")
+    # a report in whole second 8 was received at 8.5 s (tdm.frontend.ais): in view from epoch 9
+    assert echo["first_in_range_s"] == 9.0 and echo["latency_s"] == 0.0 and echo["epochs_in_range"] == 12
+    # echo's 9 reports before its first AIS report are neither matched nor false; alpha (no report received)
+    # stays in view through the radar
+    assert m["ignored_reports"] == before["ignored_reports"] + 9
+    assert m["matched_pairs"] == before["matched_pairs"] - 9
+    assert m["false_reports"] == before["false_reports"]
+    assert "alpha" in {o["name"] for o in m["per_object"]}
+    assert "alpha" not in {o["name"] for o in m["per_sensor"]["ais"]["per_object"]}
+
+
+def test_a_ship_leaves_the_ais_view_180_s_after_its_last_report():
+    t_s = np.arange(0.0, 400.0, 10.0)
+    truth = TruthAtEpochs(t_s=t_s, ids=np.array([1, 2]), names=["a", "b"], kinds=["ship", "ship"],
+                          east_m=np.zeros((t_s.size, 2)), north_m=np.zeros((t_s.size, 2)),
+                          cog_deg=np.zeros((t_s.size, 2)), sog_mps=np.zeros((t_s.size, 2)),
+                          ais=np.ones((t_s.size, 2), bool), range_m=np.zeros((t_s.size, 2)),
+                          own_east_m=np.zeros(t_s.size), own_north_m=np.zeros(t_s.size),
+                          mmsi=np.array([257000001, NO_MMSI]))
+    seen = ais_in_view(truth, {257000001: np.array([95.0, 30.0])})  # out of order on purpose
+    assert list(t_s[seen[:, 0]]) == list(np.arange(30.0, 280.0, 10.0))  # 30 s .. 95 + 180 s
+    assert not seen[:, 1].any()  # no MMSI: never heard

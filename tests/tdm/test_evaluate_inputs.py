@@ -80,6 +80,8 @@ TRUTH_CASES = [  # (edit, place, what)
     (set_field(3, "lat", "95.0"), "line 3", "field 'lat': 95.0 is not a finite number in [-90, 90]"),
     (set_field(3, "lon", "1e400"), "line 3", "field 'lon': Infinity is not a finite number"),
     (set_field(3, "ais", '"yes"'), "line 3", "field 'ais'"),
+    (set_field(3, "mmsi", "1234567890"), "line 3", "field 'mmsi': 1234567890 is not an MMSI"),
+    (set_field(3, "mmsi", '"257000001"'), "line 3", "field 'mmsi': '257000001' is not an MMSI"),
     (set_field(3, "centre_lat", "59.43"), "line 3", "field 'centre_lat' without 'centre_lon'"),
     (set_field(3, "centre_lon", "10.47"), "line 3", "field 'centre_lon' without 'centre_lat'"),
     (lambda ls: set_field(3, "centre_lon", "1e400")(set_field(3, "centre_lat", "59.43")(ls)), "line 3",

@@ -401,7 +401,7 @@ CASES: list[Case] = [
     Case("ais_cut_last_line", "ais.nmea cut inside its last line", at(A, cut, -12),
          OK, warn((AIS + "unparsable line skipped", 1), (AIS + "orphan fragment skipped", 1)), OK),
     Case("ais_zero_bytes", "ais.nmea of zero bytes", _bytes(A, b""), OK, OK, OK),
-    Case("ais_directory", "ais.nmea is a directory", at(A, as_dir), *[err(A, "(file)", "is a directory")] * 2, OK),
+    Case("ais_directory", "ais.nmea is a directory", at(A, as_dir), *[err(A, "(file)", "is a directory")] * 3),
     # ---- the run's outputs, broken before tdm evaluate
     Case("targets_garbage_line", "line 1 of tdm/detected_targets.jsonl is not JSON", lambda rec: None, OK, OK,
          err(TARGETS, "line 1", "not valid JSON"), outputs=_targets(lambda line: "garbage")),
