@@ -52,6 +52,11 @@ HEIGHT_KEEP, HEIGHT_GAIN = 0.9, 0.1
 #: Updates after which a track's length is smoothed rather than the largest seen (its first two
 #: detections may catch the object from one end).
 LENGTH_MAX_UPDATES = 2
+#: A detection counts towards a track's length as at most this many times the length so far (NaN lengths
+#: aside): one plot swollen by a sidelobe ring (harbour_approach seed 31: a pier's plots, 60 m, joined to a ring
+#: 1.8 km round) would otherwise make the track hundreds of metres long for several scans, and its absorbing
+#: radius with it.
+LENGTH_JUMP = 3.0
 SECONDS_PER_MINUTE = 60.0
 #: An AIS course over ground is used only above this speed over ground, m/s (0.6 kn: below it the COG
 #: of a drifting ship is noise).
@@ -342,8 +347,11 @@ class PositionTracker:
         track.x, track.p, _ = ekf.update(x, p, z, ekf.H_POSITION_SIZE, r)
         track.t_s = track.updated_s = t
         track.n_updates += 1
-        track.length_m = LENGTH_KEEP * track.length_m + LENGTH_GAIN * float(dets.length_m[j]) \
-            if track.n_updates > LENGTH_MAX_UPDATES else max(track.length_m, float(dets.length_m[j]))
+        length_m = float(dets.length_m[j])
+        if track.length_m > 0.0:  # a plot grown by a sidelobe arc or a ring (a km long) moves it by LENGTH_JUMP at most
+            length_m = min(length_m, LENGTH_JUMP * track.length_m)
+        track.length_m = LENGTH_KEEP * track.length_m + LENGTH_GAIN * length_m \
+            if track.n_updates > LENGTH_MAX_UPDATES else max(track.length_m, length_m)
         if np.isfinite(dets.height_m[j]):
             track.height_m = float(dets.height_m[j]) if not np.isfinite(track.height_m) else \
                 HEIGHT_KEEP * track.height_m + HEIGHT_GAIN * float(dets.height_m[j])

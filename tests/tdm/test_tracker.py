@@ -242,3 +242,14 @@ def test_one_object_pairs_found_all_at_once_are_those_found_pair_by_pair():
         assert pairs == _same_object_pairs_one_by_one(tracks, cfg)
         n_pairs += len(pairs)
     assert n_pairs > 50 and n_edge > 50
+
+
+def test_one_plot_swollen_by_a_sidelobe_ring_moves_the_length_by_at_most_three_times():
+    """harbour_approach seed 31: a pier's 60 m plots, once joined to a ring of sidelobes 1.8 km round."""
+    dets = scan(0.0, [[100.0, 200.0]], sigma=1.0)
+    tracker = PositionTracker("radar", CFG)
+    for k, length_m in enumerate([60.0, 60.0, 60.0, 1800.0]):
+        dets.time_s, dets.length_m = np.full(1, float(k)), np.array([length_m])
+        tracker.process(dets, np.zeros(2))
+    (track,) = tracker.tracks
+    assert track.length_m == pytest.approx(0.8 * 60.0 + 0.2 * 180.0)  # not 0.8 x 60 + 0.2 x 1800 = 408 m
