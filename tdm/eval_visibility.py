@@ -244,8 +244,8 @@ def ais_in_view(truth: TruthAtEpochs, received_s: dict[int, np.ndarray]) -> np.n
     return out
 
 
-def visibility(recording: Path, params: EvalParams, truth: TruthAtEpochs,
-               warnings: dict[str, int], ais_received_s: dict[int, np.ndarray] | None = None) -> tuple[dict, dict, dict]:
+def visibility(recording: Path, params: EvalParams, truth: TruthAtEpochs, warnings: dict[str, int],
+               ais_received_s: dict[int, np.ndarray] | None = None) -> tuple[dict, dict, dict]:
     """Per rendered sensor, the (E, K) in-range mask; per sensor whose view is ray truth, the (E, K) mask of
     objects within its range but hidden from it (occluded, below the horizon); and the parameters used.
 

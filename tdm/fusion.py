@@ -11,7 +11,10 @@
   target but lies near the footprint of a target (within ``absorb_lengths`` (0.75) of its length,
   known from AIS static data or from its tracks' measured extents, plus three standard
   deviations: the radar beam smears a ship's ends by tens of metres at range) is absorbed:
-  it belongs to that target, is not reported and does not enter the fusion.
+  it belongs to that target, is not reported and does not enter the fusion. An AIS track is never
+  absorbed (it is a ship's identity): inside the footprint of a target without AIS (by the ship's own
+  length when known) whose velocity is not known to differ from the ship's it joins that target;
+  otherwise it starts its own.
 - **Simple Fusion** (thesis eq. 3.2): ``x = (sum_i P_i^-1)^-1 sum_i P_i^-1 x_i`` over the tracks
   of the target at the output time. It ignores the cross-covariance of the per-sensor tracks,
   so its covariance is too small (REFERENCE: NEES about 5.8 against 4); ``tdm evaluate``
@@ -43,8 +46,12 @@ import numpy as np
 
 from tdm import ekf
 from tdm.association import chi2_gate, gnn, mahalanobis2
+from tdm.fusion_geometry import _EIGEN_TOLERANCE, FOOTPRINT_SIGMAS, MERGE_SIGMAS, MERGE_SPEED_MPS  # noqa: F401
+from tdm.fusion_geometry import clearly_apart as _clearly_apart
+from tdm.fusion_geometry import inside_reference as _inside_reference
+from tdm.fusion_geometry import moves_apart as _moves_apart
 from tdm.fusion_rules import consider_covariance, fuse
-from tdm.hull import hull_covariance
+from tdm.fusion_weights import with_extent, with_fragments, with_hull
 from tdm.tracker import Track, predicted_at
 
 
@@ -52,16 +59,6 @@ from tdm.tracker import Track, predicted_at
 STILL_DESCRIPTORS = frozenset({"iceberg", "fixed obstacle"})
 #: Degrees of freedom of the track-to-track gate: east and north position.
 POSITION_DOF = 2
-#: A track lies inside a target's footprint within its half length plus this many standard deviations
-#: of the track's position (the radar beam smears a ship's ends by tens of metres at range).
-FOOTPRINT_SIGMAS = 3.0
-#: Two targets without AIS are one object only if their velocities differ by less than this, m/s.
-MERGE_SPEED_MPS = 2.0
-#: ... and a target without AIS inside an AIS ship's footprint is another object when its velocity differs from
-#: the ship's by more than MERGE_SPEED_MPS plus this many standard deviations of its own velocity.
-MERGE_SIGMAS = 3.0
-#: Added to a velocity covariance before it is inverted (a still target's is singular: no course), (m/s)^2.
-VELOCITY_FLOOR_M2PS2 = 1e-9
 #: A target is a vessel once it has moved (faster than ``vessel_speed_mps`` by VESSEL_SIGMAS standard
 #: deviations of its speed) for this long, s.
 VESSEL_MOVING_S = 5.0
@@ -72,9 +69,6 @@ STILL_SPEED_FRACTION = 0.5
 #: ``max_distance_m``: looser than joining, so that a track does not flicker in and out.
 RELEASE_GATES = 4
 RELEASE_DISTANCES = 2
-#: Relative rounding allowed for a closed-form 2 x 2 eigenvalue and a distance (far above their few ulp): a footprint
-#: test closer to its edge than this is decided by the reference computation.
-_EIGEN_TOLERANCE = 1e-12
 #: The order in which the free tracks of each sensor look for a target: AIS (the identity) first.
 SENSOR_ORDER = ("ais", "lidar", "radar")
 
@@ -128,6 +122,10 @@ class FusionConfig:
     # resolution (this beamwidth at its range) as well as within the target's footprint: the radar cannot
     # resolve two echoes within a beamwidth at one range; None: the footprint alone
     radar_beam_deg: float | None = 5.2
+    # report a target without AIS that has absorbed tracks of these sensors at the mean of its member's and those
+    # tracks' positions, their scatter in its covariance (tdm.fusion_weights.with_fragments): a large object's
+    # centre lies among the parts its plots fall on
+    fragment_sensors: tuple[str, ...] = ("radar",)
 
 
 @dataclass
@@ -153,82 +151,6 @@ class FusedEstimate:
     x: np.ndarray  # (6,)
     p: np.ndarray  # (6, 6)
     sources: list[str]
-
-
-def _moves_apart(older: tuple[np.ndarray, np.ndarray], younger: tuple[np.ndarray, np.ndarray],
-                 older_has_ais: bool) -> bool:
-    """Whether the target without AIS moves otherwise than the AIS ship it lies inside: their velocity
-    difference, less MERGE_SPEED_MPS along it, lies more than MERGE_SIGMAS standard deviations out in the
-    target's own velocity covariance (a Mahalanobis distance: speed and heading errors mapped to east and
-    north by the Jacobian of the velocity).
-
-    A fragment of the AIS ship (a new radar track of its bow or stern) has an uncertain velocity and folds
-    in; a ship crossing close by, tracked long enough to know its own velocity, does not (crossing_silent_ship,
-    seeds 31-32: the silent crosser's target was folded into the overtaking ferry's as they passed, and its id
-    went to the ferry). The covariance's shape matters: a coasting crosser's heading grows uncertain (30 deg on
-    seed 35) while its speed stays known; a bound of speed error plus speed times heading error in every
-    direction (this rule's first form) let it fold into a ferry 8 m/s away in velocity.
-
-    Parameters
-    ----------
-    older, younger : tuple of (6,) and (6, 6) float
-        The two targets' fused states and covariances (:mod:`tdm.ekf`).
-    older_has_ais : bool
-        Which of the two has the AIS track.
-    """
-    (x_ais, _), (x_other, p_other) = (older, younger) if older_has_ais else (younger, older)
-    difference = ekf.velocity_en(x_ais) - ekf.velocity_en(x_other)
-    size = float(np.hypot(*difference))
-    if size <= MERGE_SPEED_MPS:
-        return False
-    beyond = difference * (1.0 - MERGE_SPEED_MPS / size)  # the difference less the margin, along it
-    speed, course = float(x_other[ekf.U]), float(x_other[ekf.PSI])
-    jacobian = np.array([[math.sin(course), speed * math.cos(course)],
-                         [math.cos(course), -speed * math.sin(course)]])  # d(east, north) / d(U, PSI)
-    index = [ekf.U, ekf.PSI]
-    cov = jacobian @ p_other[np.ix_(index, index)] @ jacobian.T + VELOCITY_FLOOR_M2PS2 * np.eye(2)
-    return float(beyond @ np.linalg.solve(cov, beyond)) > MERGE_SIGMAS**2
-
-
-def _inside_reference(state, centre: np.ndarray, half_length_m: float) -> bool:
-    """:meth:`Fuser._inside` in numpy operations (LAPACK's eigenvalue): the reference of its fast decision."""
-    x, p = state
-    sigma = np.sqrt(max(np.linalg.eigvalsh(p[:2, :2])[-1], 0.0))
-    return bool(np.hypot(*(x[:2] - centre[:2])) <= half_length_m + FOOTPRINT_SIGMAS * sigma)
-
-
-def _clearly_apart(estimates: list[tuple[np.ndarray, np.ndarray]], half_lengths_m: list[float]) -> np.ndarray:
-    """Which pairs of targets :meth:`Fuser._inside` certainly finds apart, all at once.
-
-    Parameters
-    ----------
-    estimates : list of T tuples of (6,) and (6, 6) float
-        The targets' fused states and covariances, oldest first.
-    half_lengths_m : list of T float
-        Their absorbing radii, m.
-
-    Returns
-    -------
-    (T, T) bool
-        ``[i, j]`` (i < j): target j lies outside the footprint of target i with radius ``max(half_i, half_j)``,
-        clear of the edge by more than the rounding bound of :meth:`Fuser._inside` (no pair it would find inside;
-        the pairs near the edge and the lower triangle are False: left to :meth:`Fuser._inside`).
-    """
-    n = len(estimates)
-    if n < 2:
-        return np.zeros((n, n), dtype=bool)
-    xy = np.array([x[:2] for x, _ in estimates])
-    cov = np.array([p[:2, :2] for _, p in estimates])
-    a, b, d = cov[:, 0, 0], cov[:, 1, 0], cov[:, 1, 1]
-    largest = 0.5 * (a + d) + np.hypot(0.5 * (a - d), b)
-    half = np.asarray(half_lengths_m, dtype=float)
-    radius = np.maximum(half[:, None], half[None, :]) + FOOTPRINT_SIGMAS * np.sqrt(np.maximum(largest, 0.0))[None, :]
-    distance = np.hypot(xy[None, :, 0] - xy[:, None, 0], xy[None, :, 1] - xy[:, None, 1])
-    slack = FOOTPRINT_SIGMAS * np.sqrt(_EIGEN_TOLERANCE * (np.abs(a) + np.abs(b) + np.abs(d)))[None, :] \
-        + _EIGEN_TOLERANCE * (distance + radius)
-    with np.errstate(invalid="ignore"):
-        out = distance > radius + 2.0 * slack  # NaN: False
-    return np.triu(out, 1)
 
 
 class Fuser:
@@ -312,20 +234,28 @@ class Fuser:
                     continue
                 key = (sensor, tr.track_id)
                 unresolved_m = self._unresolved_m(sensor, states[key][0], own_position_m)
-                host = next((t for t in self.targets
-                             if self._inside(states[key], self._estimate(t, states)[0],
-                                             max(self._half_length(t, live), unresolved_m))), None)
-                if host is not None:
+                ship_m = self._ship_half_length(tr.mmsi) if sensor == "ais" else math.nan
+                host = next((t for t in self.targets if (sensor != "ais" or "ais" not in t.members)
+                             and self._inside(states[key], self._estimate(t, states)[0], ship_m if math.isfinite(
+                                 ship_m) else max(self._half_length(t, live), unresolved_m))), None)
+                if host is not None and sensor == "ais":
+                    if _moves_apart(self._estimate(host, states), states[key], older_has_ais=False):
+                        host = None  # another ship close by: a target of its own
+                    else:
+                        host.members[sensor] = tr.track_id  # the ship's identity names the object, never hides in it
+                elif host is not None:
                     host.absorbed.add(key)
-                else:
+                if host is None:
                     self.targets.append(self._revive(states[key], t_s) or
                                         FusedTarget(next(self._ids), created_s=t_s))
                     self.targets[-1].members = {sensor: tr.track_id}
-        self._merge_overlapping(states, live)
+        self._merge_overlapping(states, live, own_position_m)
         out = []
-        weigh = self._with_extent(states, live) if cfg.weigh_extent else states
+        weigh = with_extent(states, live) if cfg.weigh_extent else states
         if cfg.weigh_hull:
-            weigh = self._with_hull(weigh, live)
+            weigh = with_hull(weigh, live, self.targets, self.lengths_by_mmsi, self.beams_by_mmsi, VESSEL_SIGMAS)
+        if cfg.fragment_sensors:
+            weigh = with_fragments(weigh, self.targets, cfg.fragment_sensors)
         for target in self.targets:
             x, p = self._estimate(target, weigh)
             reported_p = self._considered(target, weigh, live, p) if cfg.consider_lidar_extent else p
@@ -345,19 +275,6 @@ class Fuser:
         distance = math.hypot(float(x[0]) - float(own_position_m[0]), float(x[1]) - float(own_position_m[1]))
         return 0.5 * distance * math.radians(beam_deg)
 
-    @staticmethod
-    def _with_extent(states: dict, live: dict) -> dict:
-        """``states`` with each track's centre uncertainty behind the side seen (:attr:`Track.extent_var_m2`) added
-        to its position covariance: what the output weighs with ``weigh_extent``."""
-        out = dict(states)
-        for key, tr in live.items():
-            if tr.extent_var_m2 > 0.0:
-                x, p = states[key]
-                p = p.copy()
-                p[:2, :2] += tr.extent_var_m2 * np.eye(2)
-                out[key] = (x, p)
-        return out
-
     def _considered(self, target: FusedTarget, states: dict, live: dict, p: np.ndarray) -> np.ndarray:
         """``p`` (6, 6), the target's fused covariance, with its LiDAR track's extent variance taken through the
         fusion (``consider_lidar_extent``, :func:`tdm.fusion_rules.consider_covariance`)."""
@@ -368,25 +285,6 @@ class Fuser:
         xs = np.array([states[k][0] for k in keys])
         ps = np.array([states[k][1] for k in keys])
         return p + consider_covariance(xs, ps, var, self.config.rule)
-
-    def _with_hull(self, states: dict, live: dict) -> dict:
-        """``states`` with the hull's variance (``weigh_hull``, :func:`hull_covariance`) added to the position
-        covariance of the radar member of every target whose AIS track's MMSI has a known length."""
-        out = None
-        for target in self.targets:
-            ais_key = ("ais", target.members.get("ais", -1))
-            length_m = self.lengths_by_mmsi.get(live[ais_key].mmsi, math.nan) if ais_key in live else math.nan
-            radar_key = ("radar", target.members.get("radar", -1))
-            if radar_key not in live or not math.isfinite(length_m):
-                continue
-            x_ais, p_ais = states[ais_key]
-            out = dict(states) if out is None else out
-            x, p = states[radar_key]
-            p = p.copy()
-            p[:2, :2] += hull_covariance(length_m, self.beams_by_mmsi.get(live[ais_key].mmsi, math.nan), x_ais, p_ais,
-                                         VESSEL_SIGMAS)
-            out[radar_key] = (x, p)
-        return states if out is None else out
 
     def _behind_the_face(self, states: dict, live: dict, own_m: np.ndarray) -> None:
         """Move the radar tracks of still targets without AIS along the line of sight by
@@ -439,6 +337,18 @@ class Fuser:
             memo[key] = out
         return out
 
+    def _ship_half_length(self, mmsi: int | None) -> float:
+        """The absorbing radius of the AIS ship ``mmsi`` from its static length alone, m; NaN when unknown.
+
+        What decides whether an AIS ship and another target are one object: the transponder's dimensions are the
+        ship's, where a radar track's extent can hold a sidelobe arc or the quay it lies against (harbour_approach
+        seed 31: a pier's radar target, its extent grown by a ring of sidelobes, took the AIS of a tanker 400 m
+        away).
+        """
+        length_m = self.lengths_by_mmsi.get(mmsi, math.nan) if mmsi is not None else math.nan
+        return max(self.config.min_extent_m, self.config.absorb_lengths * length_m) if math.isfinite(length_m) \
+            else math.nan
+
     @staticmethod
     def _inside(state, centre: np.ndarray, half_length_m: float) -> bool:
         """Whether the track's position lies within ``half_length_m`` plus FOOTPRINT_SIGMAS standard deviations (along
@@ -479,10 +389,12 @@ class Fuser:
             best.absorbed = set()
         return best
 
-    def _merge_overlapping(self, states, live) -> None:
+    def _merge_overlapping(self, states, live, own_position_m: np.ndarray | None = None) -> None:
         """Fold a target into an older one when both are the same object.
 
-        Same object: one lies inside the other's footprint (as for absorbing tracks), they are not a
+        Same object: one lies inside the other's footprint (as for absorbing tracks; when one of them is an AIS
+        ship of known length, inside that ship's footprint or the radar's resolution: :meth:`_merge_radius`),
+        they are not a
         still target and a moving one (:meth:`_passing`), and either
         exactly one of them has an AIS track (a radar or LiDAR target of an AIS ship) and the other's
         velocity is not known to differ from the AIS ship's (:func:`_moves_apart`: two ships crossing),
@@ -492,7 +404,8 @@ class Fuser:
         targets = sorted(self.targets, key=lambda t: (t.created_s, t.target_id))
         est = {t.target_id: self._estimate(t, states) for t in targets}
         half = {t.target_id: self._half_length(t, live) for t in targets}
-        apart = _clearly_apart([est[t.target_id] for t in targets], [half[t.target_id] for t in targets])
+        reach = [self._merge_reach(t, est, half, live, own_position_m) for t in targets]
+        apart = _clearly_apart([est[t.target_id] for t in targets], reach)
         gone: set[int] = set()
         for i, older in enumerate(targets):
             if older.target_id in gone:
@@ -504,7 +417,7 @@ class Fuser:
                     continue
                 xo, _ = est[older.target_id]
                 xy, py = est[younger.target_id]
-                radius = max(half[older.target_id], half[younger.target_id])
+                radius = self._merge_radius(older, younger, est, half, live, own_position_m)
                 if not self._inside((xy, py), xo, radius) or self._passing(older, xo, younger, xy):
                     continue
                 n_ais = ("ais" in older.members) + ("ais" in younger.members)
@@ -527,6 +440,30 @@ class Fuser:
                 est[older.target_id] = self._estimate(older, states)
                 half[older.target_id] = self._half_length(older, live)
         self.targets = [t for t in self.targets if t.target_id not in gone]
+
+    def _merge_radius(self, older: FusedTarget, younger: FusedTarget, est: dict, half: dict, live: dict,
+                      own_position_m: np.ndarray | None) -> float:
+        """Within this of one another (plus the younger's 3 sigma) two targets may be one object, m: the larger of
+        their absorbing radii, or, when exactly one is an AIS ship of known length, that ship's
+        (:meth:`_ship_half_length`), or half the radar's cross-range resolution at the other's range if larger (its
+        radar track may lie anywhere across the beam)."""
+        ais, other = (older, younger) if "ais" in older.members else (younger, older)
+        ship_m = self._ship_half_length(live[("ais", ais.members["ais"])].mmsi) \
+            if "ais" in ais.members and "ais" not in other.members else math.nan
+        if not math.isfinite(ship_m):
+            return max(half[older.target_id], half[younger.target_id])
+        sensor = "radar" if "radar" in other.members else ""
+        return max(ship_m, self._unresolved_m(sensor, est[other.target_id][0], own_position_m))
+
+    def _merge_reach(self, target: FusedTarget, est: dict, half: dict, live: dict,
+                     own_position_m: np.ndarray | None) -> float:
+        """The largest :meth:`_merge_radius` of ``target`` with any other, m (what the vectorised first look,
+        :func:`_clearly_apart`, must allow for)."""
+        ship_m = self._ship_half_length(live[("ais", target.members["ais"])].mmsi) if "ais" in target.members \
+            else math.nan
+        sensor = "radar" if "radar" in target.members else ""
+        return max(half[target.target_id], ship_m if math.isfinite(ship_m) else 0.0,
+                   self._unresolved_m(sensor, est[target.target_id][0], own_position_m))
 
     def _passing(self, a: FusedTarget, xa: np.ndarray, b: FusedTarget, xb: np.ndarray) -> bool:
         """One target has settled as still (iceberg, fixed obstacle) and the other moves: a ship passing a

@@ -349,3 +349,36 @@ def test_a_new_radar_track_within_the_beams_resolution_of_a_target_is_absorbed(a
     lidar = make_track(3, "lidar", -across_m, 600.0, var=4.0)  # the rule is the radar's: a LiDAR track is resolved
     assert len(fuser.step(3.0, {"radar": [first, second], "lidar": [lidar]}, own_m)) == len(out) + 1
 
+
+
+def test_an_ais_track_is_never_absorbed():
+    """harbour_approach seed 31: the moored supply ship's AIS track lay inside the footprint of the radar target of
+    the pier it is moored to (one echo) and was absorbed: the ship was never reported with its MMSI. An AIS track
+    inside a target without AIS joins it; inside an AIS ship's footprint it is a ship of its own."""
+    fuser = Fuser(FusionConfig())
+    fuser.lengths_by_mmsi = {257000002: 100.0, 257000003: 30.0}
+    pier = make_track(1, "radar", 0.0, 0.0, var=4.0)
+    pier.length_m = 120.0  # absorbing radius 90 m
+    (radar_only,) = fuser.step(1.0, {"radar": [pier]})
+    supply = make_track(5, "ais", 0.0, 70.0, var=5.0, mmsi=257000002)  # beyond the 60 m join distance
+    (both,) = fuser.step(2.0, {"radar": [pier], "ais": [supply]})
+    assert both.target.target_id == radar_only.target.target_id and both.target.mmsi == 257000002
+    tug = make_track(6, "ais", 10.0, 60.0, var=5.0, mmsi=257000003)  # alongside the supply ship
+    out = fuser.step(3.0, {"radar": [pier], "ais": [supply, tug]})
+    assert sorted(e.target.mmsi for e in out if e.target.mmsi) == [257000002, 257000003]
+
+
+def test_a_target_swollen_by_sidelobes_does_not_take_an_ais_ship_beyond_that_ships_length():
+    """harbour_approach seed 31: the pier's radar target, its extent grown to 900 m by a sidelobe ring, took the AIS
+    of an anchored 120 m tanker 400 m away (one object by the pier's footprint): the AIS ship's length decides."""
+    fuser = Fuser(FusionConfig())
+    fuser.lengths_by_mmsi = {257000201: 120.0}
+    pier = make_track(1, "radar", 0.0, 0.0, var=4.0)
+    pier.length_m = 900.0
+    (first,) = fuser.step(1.0, {"radar": [pier]})
+    tanker = make_track(5, "ais", -300.0, -260.0, var=5.0, mmsi=257000201)
+    for t_s in (2.0, 3.0):
+        out = fuser.step(t_s, {"radar": [pier], "ais": [tanker]})
+        assert len(out) == 2 and sorted(e.sources for e in out) == [["ais"], ["radar"]]
+        (pier_out,) = [e for e in out if e.sources == ["radar"]]
+        assert pier_out.target.target_id == first.target.target_id and not pier_out.target.absorbed

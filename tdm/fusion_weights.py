@@ -1,0 +1,96 @@
+"""What the fusion's output weighs: the per-sensor tracks' states as :class:`tdm.fusion.Fuser` reports them.
+
+Each function takes ``states`` ({(sensor, track id): ((6,) state, (6, 6) covariance)}, :mod:`tdm.ekf`) and
+returns it with some tracks' entries replaced (new arrays; the tracks and the input untouched). The gates and
+absorbing radii keep the filters' own states; only the reported fusion sees these.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from tdm.hull import hull_covariance
+
+__all__ = ["with_extent", "with_fragments", "with_hull"]
+
+
+def with_extent(states: dict, live: dict) -> dict:
+    """``states`` with each track's centre uncertainty behind the side seen (``Track.extent_var_m2``, m^2 per axis)
+    added to its position covariance (``FusionConfig.weigh_extent``)."""
+    out = dict(states)
+    for key, tr in live.items():
+        if tr.extent_var_m2 > 0.0:
+            x, p = states[key]
+            p = p.copy()
+            p[:2, :2] += tr.extent_var_m2 * np.eye(2)
+            out[key] = (x, p)
+    return out
+
+
+def with_hull(states: dict, live: dict, targets: list, lengths_by_mmsi: dict[int, float],
+              beams_by_mmsi: dict[int, float], sigmas: float) -> dict:
+    """``states`` with the hull's variance (:func:`tdm.hull.hull_covariance`) added to the position covariance of
+    the radar member of every target whose AIS track's MMSI has a known length (``FusionConfig.weigh_hull``).
+
+    Parameters
+    ----------
+    targets : list of FusedTarget
+    lengths_by_mmsi, beams_by_mmsi : dict of int to float
+        AIS static length and beam, m.
+    sigmas : float
+        Standard deviations of course uncertainty the hull's orientation spans (:func:`hull_covariance`).
+    """
+    out = None
+    for target in targets:
+        ais_key = ("ais", target.members.get("ais", -1))
+        length_m = lengths_by_mmsi.get(live[ais_key].mmsi, math.nan) if ais_key in live else math.nan
+        radar_key = ("radar", target.members.get("radar", -1))
+        if radar_key not in live or not math.isfinite(length_m):
+            continue
+        x_ais, p_ais = states[ais_key]
+        out = dict(states) if out is None else out
+        x, p = states[radar_key]
+        p = p.copy()
+        p[:2, :2] += hull_covariance(length_m, beams_by_mmsi.get(live[ais_key].mmsi, math.nan), x_ais, p_ais, sigmas)
+        out[radar_key] = (x, p)
+    return states if out is None else out
+
+
+def with_fragments(states: dict, targets: list, sensors: tuple[str, ...] = ("radar",)) -> dict:
+    """``states`` with the member of ``sensors`` of every target without AIS that has absorbed tracks of the same
+    sensor put at the mean position of the member and those tracks, their scatter added to its covariance.
+
+    A large object (a ship end-on, a pier with a ship alongside, a tanker) paints several plots and so several
+    tracks; the target follows the oldest, on one part of it, and absorbs the others (:class:`tdm.fusion.Fuser`).
+    The object's centre lies among its parts: their mean, with their scatter (the population covariance of the
+    positions, m^2) as the uncertainty of where among them the centre is.
+
+    Parameters
+    ----------
+    states : dict
+        (sensor, track id) -> ((6,), (6, 6)).
+    targets : list of FusedTarget
+    sensors : tuple of str
+        The sensors whose members are moved.
+    """
+    out = None
+    for target in targets:
+        if "ais" in target.members or not target.absorbed:
+            continue
+        for sensor in sensors:
+            key = (sensor, target.members.get(sensor, -1))
+            parts = [k for k in target.absorbed if k[0] == sensor and k in states]
+            if key not in states or not parts:
+                continue
+            xy = np.array([states[k][0][:2] for k in (key, *sorted(parts))])
+            centre = xy.mean(axis=0)
+            scatter = (xy - centre).T @ (xy - centre) / xy.shape[0]
+            x, p = states[key]
+            x, p = x.copy(), p.copy()
+            x[:2] = centre
+            p[:2, :2] += scatter
+            out = dict(states) if out is None else out
+            out[key] = (x, p)
+    return states if out is None else out
