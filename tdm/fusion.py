@@ -230,25 +230,8 @@ class Fuser:
                 candidates[ti].members[sensor] = free[fi].track_id
                 joined.add(fi)
             for fi, tr in enumerate(free):
-                if fi in joined:
-                    continue
-                key = (sensor, tr.track_id)
-                unresolved_m = self._unresolved_m(sensor, states[key][0], own_position_m)
-                ship_m = self._ship_half_length(tr.mmsi) if sensor == "ais" else math.nan
-                host = next((t for t in self.targets if (sensor != "ais" or "ais" not in t.members)
-                             and self._inside(states[key], self._estimate(t, states)[0], ship_m if math.isfinite(
-                                 ship_m) else max(self._half_length(t, live), unresolved_m))), None)
-                if host is not None and sensor == "ais":
-                    if _moves_apart(self._estimate(host, states), states[key], older_has_ais=False):
-                        host = None  # another ship close by: a target of its own
-                    else:
-                        host.members[sensor] = tr.track_id  # the ship's identity names the object, never hides in it
-                elif host is not None:
-                    host.absorbed.add(key)
-                if host is None:
-                    self.targets.append(self._revive(states[key], t_s) or
-                                        FusedTarget(next(self._ids), created_s=t_s))
-                    self.targets[-1].members = {sensor: tr.track_id}
+                if fi not in joined:
+                    self._place(sensor, tr, states, live, t_s, own_position_m)
         self._merge_overlapping(states, live, own_position_m)
         out = []
         weigh = with_extent(states, live) if cfg.weigh_extent else states
@@ -266,6 +249,29 @@ class Fuser:
             self._classify(target, x, p, t_s, heights[0] if heights else float("nan"))
             out.append(FusedEstimate(target, x, reported_p, sorted(target.members)))
         return out
+
+    def _place(self, sensor: str, tr: Track, states: dict, live: dict, t_s: float,
+               own_position_m: np.ndarray | None) -> None:
+        """A track that joined no target: absorbed by a target whose footprint (or, for radar, the beam's
+        resolution) holds it; an AIS track instead joins such a target without AIS whose velocity is not known
+        to differ (by the ship's own length when known), as the ship's identity never hides in a target;
+        otherwise a new target, or a recently ended one revived."""
+        key = (sensor, tr.track_id)
+        unresolved_m = self._unresolved_m(sensor, states[key][0], own_position_m)
+        ship_m = self._ship_half_length(tr.mmsi) if sensor == "ais" else math.nan
+        host = next((t for t in self.targets if (sensor != "ais" or "ais" not in t.members)
+                     and self._inside(states[key], self._estimate(t, states)[0], ship_m if math.isfinite(ship_m)
+                                      else max(self._half_length(t, live), unresolved_m))), None)
+        if host is not None and sensor == "ais":
+            if _moves_apart(self._estimate(host, states), states[key], older_has_ais=False):
+                host = None  # another ship close by: a target of its own
+            else:
+                host.members[sensor] = tr.track_id
+        elif host is not None:
+            host.absorbed.add(key)
+        if host is None:
+            self.targets.append(self._revive(states[key], t_s) or FusedTarget(next(self._ids), created_s=t_s))
+            self.targets[-1].members = {sensor: tr.track_id}
 
     def _unresolved_m(self, sensor: str, x: np.ndarray, own_position_m: np.ndarray | None) -> float:
         """Half the radar's cross-range resolution at the track's range, m (``radar_beam_deg``); 0 otherwise."""
