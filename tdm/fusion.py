@@ -355,6 +355,11 @@ class Fuser:
         return max(self.config.min_extent_m, self.config.absorb_lengths * length_m) if math.isfinite(length_m) \
             else math.nan
 
+    def _target_ship_half_length(self, target: FusedTarget, live: dict) -> float:
+        """:meth:`_ship_half_length` of the target's AIS track's MMSI, m; NaN without an AIS track or length."""
+        return self._ship_half_length(live[("ais", target.members["ais"])].mmsi) if "ais" in target.members \
+            else math.nan
+
     @staticmethod
     def _inside(state, centre: np.ndarray, half_length_m: float) -> bool:
         """Whether the track's position lies within ``half_length_m`` plus FOOTPRINT_SIGMAS standard deviations (along
@@ -454,8 +459,7 @@ class Fuser:
         (:meth:`_ship_half_length`), or half the radar's cross-range resolution at the other's range if larger (its
         radar track may lie anywhere across the beam)."""
         ais, other = (older, younger) if "ais" in older.members else (younger, older)
-        ship_m = self._ship_half_length(live[("ais", ais.members["ais"])].mmsi) \
-            if "ais" in ais.members and "ais" not in other.members else math.nan
+        ship_m = self._target_ship_half_length(ais, live) if "ais" not in other.members else math.nan
         if not math.isfinite(ship_m):
             return max(half[older.target_id], half[younger.target_id])
         sensor = "radar" if "radar" in other.members else ""
@@ -465,8 +469,7 @@ class Fuser:
                      own_position_m: np.ndarray | None) -> float:
         """The largest :meth:`_merge_radius` of ``target`` with any other, m (what the vectorised first look,
         :func:`_clearly_apart`, must allow for)."""
-        ship_m = self._ship_half_length(live[("ais", target.members["ais"])].mmsi) if "ais" in target.members \
-            else math.nan
+        ship_m = self._target_ship_half_length(target, live)
         sensor = "radar" if "radar" in target.members else ""
         return max(half[target.target_id], ship_m if math.isfinite(ship_m) else 0.0,
                    self._unresolved_m(sensor, est[target.target_id][0], own_position_m))
