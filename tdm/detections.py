@@ -49,6 +49,10 @@ class Detections:
         between the plot's strongest and weakest cells (:func:`tdm.frontend.radar.radar_detections`):
         about 1 or more for an echo received through the antenna, well under 1 for a return
         narrower than the beam can make (a sea spike, interference). None for LiDAR.
+    core_width_m : (N,) float64 or None
+        For a radar plot, the cross-range width of its core (cells within ``core_db`` of its strongest) less
+        the beam's, m (:func:`tdm.frontend.radar.radar_detections`): the size of an object the beam smears.
+        None for LiDAR.
     """
 
     sensor: str
@@ -65,6 +69,7 @@ class Detections:
     range_m: np.ndarray
     strength_db: np.ndarray | None = None
     beam_fill: np.ndarray | None = None
+    core_width_m: np.ndarray | None = None
 
     def __len__(self) -> int:
         return int(self.time_s.shape[0])

@@ -90,16 +90,20 @@ class FusionConfig:
     settle_s: float = 20.0
     iceberg_area_m2: float = 60.0
     iceberg_height_m: float = 3.0
-    # a still target's (iceberg, fixed obstacle; no AIS) radar track is put this fraction of its length (its plots'
-    # extent, mostly their range extent) further along the line of sight: the radar paints a berg's near side and
-    # its centre lies behind. Fitted on busy_open_sea (seed 7, 300 s, the tuning scenario) against the bergs' body
-    # origins: the radar plots lay a median 8.2 m in front of them, their range extent a median 11.3 m (0.7); fitted
-    # again when truth gained the bergs' centres (1-3 m off their origins), over 0.3-1.3: 0.6 (median fused error
-    # beyond LiDAR range 3.94 -> 3.76 m, the bergs' median errors 3.92 -> 3.82 m; docs/tdm.md)
-    radar_hidden_depth_fraction: float = 0.6
-    # ... and the uncertainty of that depth, along the line of sight, as a fraction of the track's length (the
-    # same bergs' offsets scattered 2.8 m about their median, a quarter of their plots' range extent)
-    radar_hidden_depth_sigma_fraction: float = 0.25
+    # a still target's (iceberg, fixed obstacle; no AIS) radar track is put this fraction of its size further along
+    # the line of sight: the radar paints a berg's near side and its centre lies behind, about 0.4 of the berg's
+    # size on both busy_open_sea (20-25 m bergs) and rough_sea_rain (19-68 m). The size
+    # (``radar_hidden_depth_size``): "core_width", the running mean of its plots' core width
+    # (Detections.core_width_m, about 0.8 of a berg's size on both, where the plots' extent, cut short by rain and
+    # clutter, is 0.2-0.6); "length", the track's smoothed plot extent (until 2026-11-28, with 0.6 and 0.25).
+    # Fitted on busy_open_sea seed 7 (300 s, the tuning scenario), core width: 0.4, 0.45, 0.5, 0.55, 0.6 gave a
+    # median fused error beyond LiDAR range of 4.00, 3.80, 3.69, 3.64, 3.70 m and GOSPA 31.4, 31.4, 31.7, 32.4,
+    # 33.4 m (length, 0.6: 3.63 and 31.3 m): 0.5, with 0.4 x 1.25 behind it (docs/tdm.md, "Extended objects")
+    radar_hidden_depth_fraction: float = 0.5
+    # ... and the uncertainty of that depth, along the line of sight, as a fraction of the same size (0.15, 0.18,
+    # 0.2, 0.25 with 0.5 or 0.45: fused NEES in its interval 0.887-0.895 on the same run)
+    radar_hidden_depth_sigma_fraction: float = 0.2
+    radar_hidden_depth_size: str = "core_width"
     # weigh each track in the output with its centre's uncertainty behind the side seen (Track.reported; the
     # gates and absorbing radii keep the filters' covariances). Off: on busy_open_sea (seed 7, 300 s) it brought
     # the fused NEES to its ideal (mean 8.3 -> 2.0, in its interval 0.88 -> 0.89) and COG RMSE 5.7 -> 4.8 deg, but
@@ -126,6 +130,11 @@ class FusionConfig:
     # tracks' positions, their scatter in its covariance (tdm.fusion_weights.with_fragments): a large object's
     # centre lies among the parts its plots fall on
     fragment_sensors: tuple[str, ...] = ("radar",)
+
+    def __post_init__(self):
+        if self.radar_hidden_depth_size not in ("core_width", "length"):
+            raise ValueError(f"radar_hidden_depth_size must be 'core_width' or 'length', "
+                             f"not {self.radar_hidden_depth_size!r}")
 
 
 @dataclass
@@ -303,11 +312,19 @@ class Fuser:
             x, p = states[key]
             sight = x[:2] - own_m
             distance = float(np.hypot(*sight))
-            if distance > 0.0 and np.isfinite(live[key].length_m):
+            size_m = self._hidden_size_m(live[key])
+            if distance > 0.0 and np.isfinite(size_m):
                 x, p, u = x.copy(), p.copy(), sight / distance
-                x[:2] += self.config.radar_hidden_depth_fraction * live[key].length_m * u
-                p[:2, :2] += (self.config.radar_hidden_depth_sigma_fraction * live[key].length_m) ** 2 * np.outer(u, u)
+                x[:2] += self.config.radar_hidden_depth_fraction * size_m * u
+                p[:2, :2] += (self.config.radar_hidden_depth_sigma_fraction * size_m) ** 2 * np.outer(u, u)
                 states[key] = (x, p)
+
+    def _hidden_size_m(self, track: Track) -> float:
+        """The size of a radar track's object that its hidden depth is a fraction of, m
+        (``radar_hidden_depth_size``: its plots' smoothed core width, or its length)."""
+        if self.config.radar_hidden_depth_size == "core_width" and np.isfinite(track.core_width_m):
+            return track.core_width_m
+        return track.length_m
 
     def _estimate(self, target: FusedTarget, states) -> tuple[np.ndarray, np.ndarray]:
         """The target's fused state (6,) and covariance (6, 6) from its members' ``states``.

@@ -57,7 +57,20 @@ LENGTH_MAX_UPDATES = 2
 #: 1.8 km round) would otherwise make the track hundreds of metres long for several scans, and its absorbing
 #: radius with it.
 LENGTH_JUMP = 3.0
+#: A radar track's core width is the mean of its plots' over its last updates, about this many
+#: (a running mean, then an exponential one with this window).
+CORE_WIDTH_UPDATES = 30
 SECONDS_PER_MINUTE = 60.0
+
+
+def _smoothed_size(old_m: float, new_m: float, n_updates: int) -> float:
+    """A track's size (length or core width, m) after one more detection of ``new_m``: the largest seen for its
+    first LENGTH_MAX_UPDATES updates (they may catch the object from one end), then an exponential moving average
+    (LENGTH_KEEP, LENGTH_GAIN); one detection counts as at most LENGTH_JUMP times the size so far (a sidelobe arc
+    or a ring, a km long, would otherwise swell it for several scans)."""
+    if old_m > 0.0:
+        new_m = min(new_m, LENGTH_JUMP * old_m)
+    return LENGTH_KEEP * old_m + LENGTH_GAIN * new_m if n_updates > LENGTH_MAX_UPDATES else max(old_m, new_m)
 #: An AIS course over ground is used only above this speed over ground, m/s (0.6 kn: below it the COG
 #: of a drifting ship is noise).
 AIS_COG_MIN_SOG_MPS = 0.3
@@ -173,6 +186,9 @@ class Track:
     n_updates : int
     mmsi : int or None
         AIS tracks only.
+    core_width_m : float
+        Radar tracks: their plots' core width (:attr:`~tdm.detections.Detections.core_width_m`), smoothed as the
+        length is, m; NaN for the other sensors.
     """
 
     track_id: int
@@ -190,6 +206,7 @@ class Track:
     first_cov_m2: np.ndarray | None = None
     height_m: float = float("nan")
     length_m: float = 0.0
+    core_width_m: float = float("nan")
     process: ekf.ProcessNoise = field(default_factory=ekf.ProcessNoise)
     extent_sigma_fraction: float = 0.0
     _last_prediction: tuple | None = field(default=None, init=False, repr=False, compare=False)
@@ -347,11 +364,12 @@ class PositionTracker:
         track.x, track.p, _ = ekf.update(x, p, z, ekf.H_POSITION_SIZE, r)
         track.t_s = track.updated_s = t
         track.n_updates += 1
-        length_m = float(dets.length_m[j])
-        if track.length_m > 0.0:  # a plot grown by a sidelobe arc or a ring (a km long) moves it by LENGTH_JUMP at most
-            length_m = min(length_m, LENGTH_JUMP * track.length_m)
-        track.length_m = LENGTH_KEEP * track.length_m + LENGTH_GAIN * length_m \
-            if track.n_updates > LENGTH_MAX_UPDATES else max(track.length_m, length_m)
+        track.length_m = _smoothed_size(track.length_m, float(dets.length_m[j]), track.n_updates)
+        if dets.core_width_m is not None:
+            core_m = float(dets.core_width_m[j])
+            gain = 1.0 / min(track.n_updates, CORE_WIDTH_UPDATES)
+            track.core_width_m = core_m if np.isnan(track.core_width_m) else \
+                (1.0 - gain) * track.core_width_m + gain * min(core_m, LENGTH_JUMP * max(track.core_width_m, 1.0))
         if np.isfinite(dets.height_m[j]):
             track.height_m = float(dets.height_m[j]) if not np.isfinite(track.height_m) else \
                 HEIGHT_KEEP * track.height_m + HEIGHT_GAIN * float(dets.height_m[j])
@@ -400,6 +418,7 @@ class PositionTracker:
         track = Track(next(self._ids), self.sensor, x, p, t, t, t,
                       first_position_m=dets.position_m[j].copy(), first_cov_m2=cov_j.copy(),
                       height_m=float(dets.height_m[j]), length_m=float(dets.length_m[j]), process=cfg.process,
+                      core_width_m=float(dets.core_width_m[j]) if dets.core_width_m is not None else float("nan"),
                       extent_sigma_fraction=cfg.extent_sigma_fraction)
         self._record(track, self._hit_weight(dets, j))
         self.tracks.append(track)

@@ -104,6 +104,9 @@ UNIFORM_VARIANCE_DIVISOR = 12.0
 #: The two-way beam ``exp(-8 ln2 theta^2 / theta3^2)`` is the one-way beam squared: its smear between
 #: two powers is the one-way width over sqrt(2) (:func:`radar_detections`, cross-range extent).
 TWO_WAY = 2.0
+#: The two-way Gaussian beam is down by this many dB at its one-way -3 dB width, ``20 log10(2)``: its width at
+#: ``x`` dB down is ``theta3 sqrt(x / 6.02)`` (:func:`_core_widths`).
+TWO_WAY_HALF_POWER_DB = 20.0 * np.log10(2.0)
 #: Smallest norm of a horizontal beam direction before it is normalised (no division by zero).
 _MIN_DIRECTION_NORM = 1e-12
 #: Cells per block of spokes the detection steps work on at a time (their per-cell arrays stay in cache).
@@ -369,6 +372,21 @@ def _extents(plots: _Plots, power: np.ndarray, azimuth_deg: np.ndarray, bearing_
     return len_r_m, len_c_m, beam_fill
 
 
+def _core_widths(plots: _Plots, power: np.ndarray, azimuth_deg: np.ndarray, bearing_rel_deg: np.ndarray,
+                 plot_range_m: np.ndarray, n_spokes: int, config: RadarFrontEndConfig) -> np.ndarray:
+    """(m,) cross-range width of each plot's core, m: the azimuth extent of its cells within ``core_db`` of its
+    strongest, less in quadrature the width the two-way Gaussian beam paints down to ``core_db``
+    (``theta3 sqrt(core_db / 6.02)``), times its range; 0 where the core is no wider than the beam."""
+    lab = plots.label
+    power_max = _label_max_min(power, lab, plots.n)[0]
+    core = power >= power_max[lab] * 10.0 ** (-config.core_db / 10.0)
+    d_az = _wrap_deg(azimuth_deg[plots.spoke[core]] - bearing_rel_deg[lab[core]])
+    az_max, az_min = _label_max_min(d_az, lab[core], plots.n)
+    core_deg = az_max - az_min + 360.0 / n_spokes
+    beam_deg = config.beam_az_deg * np.sqrt(config.core_db / TWO_WAY_HALF_POWER_DB)
+    return plot_range_m * np.radians(np.sqrt(np.maximum(core_deg ** 2 - beam_deg ** 2, 0.0)))
+
+
 def _label_max_min(values: np.ndarray, lab: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
     """(n,) largest and (n,) smallest of ``values`` (M,) per label 0..n-1 of ``lab`` (M,), in the values' dtype
     (``scipy.ndimage.maximum`` / ``minimum``; every label holds a cell)."""
@@ -467,6 +485,10 @@ def radar_detections(sweep: dict, track: OwnshipTrack, mount: Mount, config: Rad
           the antenna can be (a sea spike; busy_open_sea, sea state 4: of the plots from 15 dB over
           their background, clutter's have a median fill of 0.17 and 86 % are under 0.5, objects'
           a median of 1.1 and 1 % under 0.5, benchmarks/results/tdm_criteria.md);
+        - ``core_width_m = r sqrt(core_az^2 - (theta3 sqrt(c / 6.02))^2)`` (radians, 0 if negative): the width
+          of the cells within ``c = core_db`` of the strongest, less the two-way beam's width ``c`` dB down, in
+          quadrature; the size of an object the beam does not resolve, which ``Lc`` (taken down to the plot's
+          weakest cell) loses in a saturated echo (docs/tdm.md, "Extended objects");
         - ``cross_section_m2 = Lr Lc`` (the visible footprint); ``length_m`` / ``width_m`` the larger
           / smaller; ``orientation_deg`` the plot's bearing when the range extent is the longer,
           else the bearing + 90 deg, mod 180.
@@ -502,7 +524,8 @@ def radar_detections(sweep: dict, track: OwnshipTrack, mount: Mount, config: Rad
         width_m=np.minimum(len_r, len_c)[k], orientation_deg=orientation[k],
         height_m=np.full(int(np.count_nonzero(k)), np.nan),
         n_cells=np.bincount(plots.label, minlength=plots.n).astype(np.int64)[k], range_m=plot_range_m[k],
-        strength_db=plots.margin_db[k], beam_fill=beam_fill[k])
+        strength_db=plots.margin_db[k], beam_fill=beam_fill[k],
+        core_width_m=_core_widths(plots, power, azimuth_deg, bearing_rel_deg, plot_range_m, n_spokes, config)[k])
 
 
 def _sweep_land_blocks(land: LandMask | None, azimuth_deg: np.ndarray, heading_deg: np.ndarray, time_s: np.ndarray,

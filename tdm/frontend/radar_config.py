@@ -114,6 +114,12 @@ class RadarFrontEndConfig:
         truth centres 0.5-1.5) the plots' real scatter (about 2 m on the Table 3.2 vessel) was
         reported as 10 m and the radar tracks lagged every turn; 0.25 halves their heading error
         (benchmarks/results/thesis_table32.md).
+    core_db : float
+        How far under a plot's strongest cell its core reaches, dB (``Detections.core_width_m``: the
+        cross-range width of those cells less the two-way beam's width as many dB down). Default 9: three
+        video levels of 3 dB, so that a saturated echo's core still spans several levels. Looked at on
+        busy_open_sea seed 31 (its bergs 20-25 m): 3 dB gave a median 0-11 m (one or two levels, ruled by the
+        spoke quantisation), 6, 9 and 12 dB 12-34, 15-27 and 15-28 m.
     land_beam_fraction : float
         With a chart (the recording's land), plots within ``range sin(land_beam_fraction beam_az_deg)``
         of the land are dropped as the land's own echo smeared by the beam (:func:`tdm.land.beam_margin_m`).
@@ -179,6 +185,7 @@ class RadarFrontEndConfig:
     blanking_m: float = 3.0
     bearing_sigma_beam_fraction: float = 0.15
     extent_sigma_fraction: float = 0.25
+    core_db: float = 9.0
     land_beam_fraction: float = 0.5
     clutter_map_without_land: bool = True
     land_clear_beam_fraction: float = 1.0
@@ -202,6 +209,8 @@ class RadarFrontEndConfig:
             raise ValueError(f"os_rank must be in 1..training_cells, not {self.os_rank}")
         if not 0.0 < self.clutter_quantile <= 1.0:
             raise ValueError(f"clutter_quantile must be in (0, 1], not {self.clutter_quantile}")
+        if not self.core_db > 0.0:
+            raise ValueError(f"core_db must be > 0, not {self.core_db}")
         for name in ("clutter_window_blocks", "clutter_guard_blocks"):
             a, r = getattr(self, name)
             if a < 1 or r < 1 or a % 2 == 0 or r % 2 == 0:

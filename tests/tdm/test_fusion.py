@@ -60,8 +60,9 @@ def make_track(track_id, sensor, east, north, var=4.0, t=0.0, mmsi=None):
 
 
 def test_a_still_targets_radar_track_is_put_its_hidden_depth_behind_the_face_along_the_line_of_sight():
-    """A berg's radar track 500 m north of the own ship, 12 m long: reported 0.7 x 12 m farther north once the
-    target is still (an iceberg); a vessel's, or a track with AIS, as it is."""
+    """A berg's radar track 500 m north of the own ship, 12 m long (no core width: its length is its size): reported
+    ``radar_hidden_depth_fraction`` x 12 m farther north once the target is still (an iceberg); a vessel's, or a
+    track with AIS, as it is."""
     fuser = Fuser(FusionConfig())
     radar = make_track(1, "radar", 0.0, 500.0)
     radar.length_m = 12.0
@@ -81,6 +82,23 @@ def test_a_still_targets_radar_track_is_put_its_hidden_depth_behind_the_face_alo
     still.target.descriptor = "vessel"
     (vessel,) = fuser.step(3.0, {"radar": [radar]}, own)
     assert vessel.x[:2] == pytest.approx([0.0, 500.0])
+
+
+def test_the_hidden_depth_is_a_fraction_of_the_radar_tracks_core_width_when_it_has_one():
+    """A 68 m berg whose rain-cut plots are 12 m long but whose core width is 55 m: put 0.5 x 55 m behind its face,
+    not 0.5 x 12 m; with ``radar_hidden_depth_size="length"`` as before, by its length."""
+    own = np.array([0.0, 0.0])
+    for size, expected_m in (("core_width", 55.0), ("length", 12.0)):
+        config = FusionConfig(radar_hidden_depth_size=size)
+        fuser = Fuser(config)
+        radar = make_track(1, "radar", 0.0, 500.0)
+        radar.length_m, radar.core_width_m = 12.0, 55.0
+        (first,) = fuser.step(0.0, {"radar": [radar]}, own)
+        first.target.descriptor = "iceberg"
+        (still,) = fuser.step(1.0, {"radar": [radar]}, own)
+        assert still.x[:2] == pytest.approx([0.0, 500.0 + config.radar_hidden_depth_fraction * expected_m])
+    with pytest.raises(ValueError, match="radar_hidden_depth_size"):
+        FusionConfig(radar_hidden_depth_size="width")
 
 
 def test_tracks_of_one_object_share_a_target_and_ids_stay_stable():

@@ -253,3 +253,25 @@ def test_one_plot_swollen_by_a_sidelobe_ring_moves_the_length_by_at_most_three_t
         tracker.process(dets, np.zeros(2))
     (track,) = tracker.tracks
     assert track.length_m == pytest.approx(0.8 * 60.0 + 0.2 * 180.0)  # not 0.8 x 60 + 0.2 x 1800 = 408 m
+
+
+def test_a_radar_tracks_core_width_is_the_running_mean_of_its_plots_and_a_ring_moves_it_threefold_at_most():
+    """A berg's plots' core widths scatter (glints); the track keeps their mean over its last CORE_WIDTH_UPDATES
+    updates: 10 and 30 m alternating give 20 m, where the exponential smoothing of the length would swing with
+    them. A track from plots without a core width (LiDAR) has none."""
+    from tdm.tracker import CORE_WIDTH_UPDATES
+    dets = scan(0.0, [[100.0, 200.0]], sigma=1.0)
+    tracker = PositionTracker("radar", CFG)
+    widths = [10.0, 30.0] * 10
+    for k, width_m in enumerate(widths):
+        dets.time_s, dets.core_width_m = np.full(1, float(k)), np.array([width_m])
+        tracker.process(dets, np.zeros(2))
+    (track,) = tracker.tracks
+    assert len(widths) < CORE_WIDTH_UPDATES and track.core_width_m == pytest.approx(np.mean(widths))
+    dets.time_s, dets.core_width_m = np.full(1, 20.0), np.array([1800.0])
+    tracker.process(dets, np.zeros(2))
+    assert track.core_width_m == pytest.approx((20.0 * 20 + 60.0) / 21)  # the ring counts as 3 x 20 m
+    lidar = PositionTracker("lidar", CFG)
+    lidar_dets = scan(0.0, [[100.0, 200.0]])
+    lidar.process(lidar_dets, np.zeros(2))
+    assert np.isnan(lidar.tracks[0].core_width_m)
