@@ -95,7 +95,7 @@ class FusionConfig:
     # size on both busy_open_sea (20-25 m bergs) and rough_sea_rain (19-68 m). The size
     # (``radar_hidden_depth_size``): "core_width", the running mean of its plots' core width
     # (Detections.core_width_m, about 0.8 of a berg's size on both, where the plots' extent, cut short by rain and
-    # clutter, is 0.2-0.6); "length", the track's smoothed plot extent (until 2026-11-28, with 0.6 and 0.25).
+    # clutter, is 0.2-0.6); "length", the track's smoothed plot extent (the rule until 2026-11-28, below).
     # Fitted on busy_open_sea seed 7 (300 s, the tuning scenario), core width: 0.4, 0.45, 0.5, 0.55, 0.6 gave a
     # median fused error beyond LiDAR range of 4.00, 3.80, 3.69, 3.64, 3.70 m and GOSPA 31.4, 31.4, 31.7, 32.4,
     # 33.4 m (length, 0.6: 3.63 and 31.3 m): 0.5, with 0.4 x 1.25 behind it (docs/tdm.md, "Extended objects")
@@ -104,6 +104,20 @@ class FusionConfig:
     # 0.2, 0.25 with 0.5 or 0.45: fused NEES in its interval 0.887-0.895 on the same run)
     radar_hidden_depth_sigma_fraction: float = 0.2
     radar_hidden_depth_size: str = "core_width"
+    # ... where the core width spans this many beamwidths at the track's range or more; under it the core width is
+    # ill-conditioned (its slope core/width: a few tenths of a degree of yaw or spoke quantisation move it by tens
+    # of metres: busy_open_sea's 20 m berg at 820 m and crossing_silent_ship's 50 m berg_far at 1.3 km gave 1.6 and
+    # 1.2 times their size, where nearer bergs give 0.6-0.9 of it) and
+    # the length rule below holds. Fitted on busy_open_sea seed 7: 0, 0.3, 0.5, 0.7 gave a median fused error beyond
+    # LiDAR range of 3.69, 3.52, 3.47, 3.59 m and GOSPA 31.7, 31.3, 31.0, 31.1 m
+    radar_core_width_min_beams: float = 0.5
+    # the length rule (the only one until 2026-11-28): this fraction of the track's length (its plots' smoothed
+    # extent, mostly their range extent), fitted on busy_open_sea seed 7 over 0.3-1.3 (median fused error beyond
+    # LiDAR range 5.00, 4.16, 3.72, 3.76, 3.94, 5.47, 7.78, 9.84 m for 0.3, 0.4, 0.5, 0.6, 0.7, 0.9, 1.1, 1.3; the
+    # bergs' median errors smallest at 0.6), with a quarter of the length as the depth's sigma (the bergs' offsets
+    # scattered 2.8 m about their median)
+    radar_hidden_depth_length_fraction: float = 0.6
+    radar_hidden_depth_length_sigma_fraction: float = 0.25
     # weigh each track in the output with its centre's uncertainty behind the side seen (Track.reported; the
     # gates and absorbing radii keep the filters' covariances). Off: on busy_open_sea (seed 7, 300 s) it brought
     # the fused NEES to its ideal (mean 8.3 -> 2.0, in its interval 0.88 -> 0.89) and COG RMSE 5.7 -> 4.8 deg, but
@@ -312,19 +326,24 @@ class Fuser:
             x, p = states[key]
             sight = x[:2] - own_m
             distance = float(np.hypot(*sight))
-            size_m = self._hidden_size_m(live[key])
-            if distance > 0.0 and np.isfinite(size_m):
+            depth_m, sigma_m = self._hidden_depth_m(live[key], distance)
+            if distance > 0.0 and np.isfinite(depth_m):
                 x, p, u = x.copy(), p.copy(), sight / distance
-                x[:2] += self.config.radar_hidden_depth_fraction * size_m * u
-                p[:2, :2] += (self.config.radar_hidden_depth_sigma_fraction * size_m) ** 2 * np.outer(u, u)
+                x[:2] += depth_m * u
+                p[:2, :2] += sigma_m ** 2 * np.outer(u, u)
                 states[key] = (x, p)
 
-    def _hidden_size_m(self, track: Track) -> float:
-        """The size of a radar track's object that its hidden depth is a fraction of, m
-        (``radar_hidden_depth_size``: its plots' smoothed core width, or its length)."""
-        if self.config.radar_hidden_depth_size == "core_width" and np.isfinite(track.core_width_m):
-            return track.core_width_m
-        return track.length_m
+    def _hidden_depth_m(self, track: Track, distance_m: float) -> tuple[float, float]:
+        """How far a still radar track's object's centre lies behind its plots, and that depth's standard deviation,
+        m: fractions of its plots' core width where that spans ``radar_core_width_min_beams`` beamwidths at
+        ``distance_m`` or more (``radar_hidden_depth_size="core_width"``), else of its length."""
+        cfg = self.config
+        core_m, beam_deg = track.core_width_m, cfg.radar_beam_deg
+        if cfg.radar_hidden_depth_size == "core_width" and np.isfinite(core_m) and \
+                core_m >= cfg.radar_core_width_min_beams * distance_m * math.radians(beam_deg or 0.0):
+            return cfg.radar_hidden_depth_fraction * core_m, cfg.radar_hidden_depth_sigma_fraction * core_m
+        length_m = track.length_m
+        return cfg.radar_hidden_depth_length_fraction * length_m, cfg.radar_hidden_depth_length_sigma_fraction * length_m
 
     def _estimate(self, target: FusedTarget, states) -> tuple[np.ndarray, np.ndarray]:
         """The target's fused state (6,) and covariance (6, 6) from its members' ``states``.

@@ -61,8 +61,8 @@ def make_track(track_id, sensor, east, north, var=4.0, t=0.0, mmsi=None):
 
 def test_a_still_targets_radar_track_is_put_its_hidden_depth_behind_the_face_along_the_line_of_sight():
     """A berg's radar track 500 m north of the own ship, 12 m long (no core width: its length is its size): reported
-    ``radar_hidden_depth_fraction`` x 12 m farther north once the target is still (an iceberg); a vessel's, or a
-    track with AIS, as it is."""
+    ``radar_hidden_depth_length_fraction`` x 12 m farther north once the target is still (an iceberg); a vessel's,
+    or a track with AIS, as it is."""
     fuser = Fuser(FusionConfig())
     radar = make_track(1, "radar", 0.0, 500.0)
     radar.length_m = 12.0
@@ -71,9 +71,9 @@ def test_a_still_targets_radar_track_is_put_its_hidden_depth_behind_the_face_alo
     assert first.x[:2] == pytest.approx([0.0, 500.0])  # not yet known to be still
     first.target.descriptor = "iceberg"
     (still,) = fuser.step(1.0, {"radar": [radar]}, own)
-    depth = FusionConfig().radar_hidden_depth_fraction * 12.0
+    depth = FusionConfig().radar_hidden_depth_length_fraction * 12.0
     assert depth > 0.0 and still.x[:2] == pytest.approx([0.0, 500.0 + depth])
-    sigma = FusionConfig().radar_hidden_depth_sigma_fraction * 12.0  # the depth's uncertainty, along the sight line
+    sigma = FusionConfig().radar_hidden_depth_length_sigma_fraction * 12.0  # the depth's uncertainty, along the sight line
     predicted = radar.predicted(1.0)[1][:2, :2]
     assert still.p[:2, :2] == pytest.approx(predicted + np.diag([0.0, sigma**2]))
     assert radar.x[:2] == pytest.approx([0.0, 500.0])  # the track itself is untouched
@@ -84,19 +84,25 @@ def test_a_still_targets_radar_track_is_put_its_hidden_depth_behind_the_face_alo
     assert vessel.x[:2] == pytest.approx([0.0, 500.0])
 
 
-def test_the_hidden_depth_is_a_fraction_of_the_radar_tracks_core_width_when_it_has_one():
-    """A 68 m berg whose rain-cut plots are 12 m long but whose core width is 55 m: put 0.5 x 55 m behind its face,
-    not 0.5 x 12 m; with ``radar_hidden_depth_size="length"`` as before, by its length."""
-    own = np.array([0.0, 0.0])
-    for size, expected_m in (("core_width", 55.0), ("length", 12.0)):
+def test_the_hidden_depth_is_a_fraction_of_the_core_width_where_the_object_spans_half_a_beam_else_of_its_length():
+    """A 68 m berg whose rain-cut plots are 12 m long but whose core width is 55 m: 500 m off (6.3 deg, over half
+    the 5.2 deg beam) put 0.5 x 55 m behind its face, not by its length; 2 km off (1.6 deg) the core width is
+    ill-conditioned (a few tenths of a degree of smear change it by tens of metres) and the length rule holds;
+    with ``radar_hidden_depth_size="length"`` the length rule holds everywhere."""
+    for size, north_m, by_core in (("core_width", 500.0, True), ("core_width", 2000.0, False),
+                                   ("length", 500.0, False)):
         config = FusionConfig(radar_hidden_depth_size=size)
         fuser = Fuser(config)
-        radar = make_track(1, "radar", 0.0, 500.0)
+        radar = make_track(1, "radar", 0.0, north_m)
         radar.length_m, radar.core_width_m = 12.0, 55.0
-        (first,) = fuser.step(0.0, {"radar": [radar]}, own)
+        (first,) = fuser.step(0.0, {"radar": [radar]}, np.zeros(2))
         first.target.descriptor = "iceberg"
-        (still,) = fuser.step(1.0, {"radar": [radar]}, own)
-        assert still.x[:2] == pytest.approx([0.0, 500.0 + config.radar_hidden_depth_fraction * expected_m])
+        (still,) = fuser.step(1.0, {"radar": [radar]}, np.zeros(2))
+        depth_m, sigma_m = ((config.radar_hidden_depth_fraction * 55.0, config.radar_hidden_depth_sigma_fraction * 55.0)
+                            if by_core else (config.radar_hidden_depth_length_fraction * 12.0,
+                                             config.radar_hidden_depth_length_sigma_fraction * 12.0))
+        assert still.x[:2] == pytest.approx([0.0, north_m + depth_m])
+        assert still.p[1, 1] == pytest.approx(radar.predicted(1.0)[1][1, 1] + sigma_m ** 2)
     with pytest.raises(ValueError, match="radar_hidden_depth_size"):
         FusionConfig(radar_hidden_depth_size="width")
 
