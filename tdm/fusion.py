@@ -277,14 +277,19 @@ class Fuser:
                own_position_m: np.ndarray | None) -> None:
         """A track that joined no target: absorbed by a target whose footprint (or, for radar, the beam's
         resolution) holds it; an AIS track instead joins such a target without AIS whose velocity is not known
-        to differ (by the ship's own length when known), as the ship's identity never hides in a target;
+        to differ (by the ship's own length when known, or half the radar's resolution at the target's range if
+        larger, as :meth:`_merge_radius` would merge them), as the ship's identity never hides in a target;
         otherwise a new target, or a recently ended one revived."""
         key = (sensor, tr.track_id)
         unresolved_m = self._unresolved_m(sensor, states[key][0], own_position_m)
         ship_m = self._ship_half_length(tr.mmsi) if sensor == "ais" else math.nan
         host = next((t for t in self.targets if (sensor != "ais" or "ais" not in t.members)
-                     and self._inside(states[key], self._estimate(t, states)[0], ship_m if math.isfinite(ship_m)
-                                      else max(self._half_length(t, live), unresolved_m))), None)
+                     and self._inside(self._against(sensor, states[key], est := self._estimate(t, states)),
+                                      centre := est[0],
+                                      max(ship_m, self._unresolved_m("radar" if "radar" in t.members else "", centre,
+                                                                     own_position_m))
+                                      if math.isfinite(ship_m) else max(self._half_length(t, live), unresolved_m))),
+                    None)
         if host is not None and sensor == "ais":
             if _moves_apart(self._estimate(host, states), states[key], older_has_ais=False):
                 host = None  # another ship close by: a target of its own
@@ -295,6 +300,17 @@ class Fuser:
         if host is None:
             self.targets.append(self._revive(states[key], t_s) or FusedTarget(next(self._ids), created_s=t_s))
             self.targets[-1].members = {sensor: tr.track_id}
+
+    @staticmethod
+    def _against(sensor: str, state: tuple, target_estimate: tuple) -> tuple:
+        """An AIS track's state with the target's position covariance added (their difference's uncertainty: a
+        target a second old is as uncertain as its first plot); another sensor's track as it is."""
+        if sensor != "ais":
+            return state
+        x, p = state
+        p = p.copy()
+        p[:2, :2] = p[:2, :2] + target_estimate[1][:2, :2]
+        return x, p
 
     def _unresolved_m(self, sensor: str, x: np.ndarray, own_position_m: np.ndarray | None) -> float:
         """Half the radar's cross-range resolution at the track's range, m (``radar_beam_deg``); 0 otherwise."""

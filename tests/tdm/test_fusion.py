@@ -107,6 +107,24 @@ def test_the_hidden_depth_is_a_fraction_of_the_core_width_where_the_object_spans
         FusionConfig(radar_hidden_depth_size="width")
 
 
+def test_an_ais_track_joins_a_new_radar_target_within_the_ships_length_and_both_uncertainties():
+    """busy_port seed 32: a 30 m ferry's first AIS report lies 36 m from the radar target started on it a second
+    before (its first plots, 370 m off: metres of cross-range uncertainty); judged by the AIS track's covariance
+    alone it started a target of its own and was merged into the radar's 7 s later, two id switches. The two
+    positions' difference has both covariances: with the radar's 8 m sigma the report joins the radar target; with a
+    radar track as certain as the AIS it stays a ship of its own."""
+    for radar_var, joined in ((64.0, True), (1.0, False)):
+        fuser = Fuser(FusionConfig())
+        fuser.lengths_by_mmsi = {367000401: 30.0}
+        radar = make_track(1, "radar", 0.0, 370.0, var=radar_var)
+        ais = make_track(1, "ais", 36.0, 370.0, var=4.0, mmsi=367000401)
+        fuser.step(0.0, {"radar": [radar]}, np.zeros(2))
+        out = fuser.step(1.0, {"radar": [radar], "ais": [ais]}, np.zeros(2))
+        assert (len(out) == 1) == joined
+        if joined:
+            assert out[0].target.members == {"radar": 1, "ais": 1} and out[0].target.mmsi == 367000401
+
+
 def test_tracks_of_one_object_share_a_target_and_ids_stay_stable():
     fuser = Fuser(FusionConfig())
     radar = [make_track(1, "radar", 0.0, 0.0, var=25.0), make_track(2, "radar", 500.0, 0.0, var=25.0)]
