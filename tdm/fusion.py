@@ -46,6 +46,7 @@ import numpy as np
 
 from tdm import ekf
 from tdm.association import chi2_gate, gnn, mahalanobis2
+from tdm.fusion_config import FusionConfig
 from tdm.fusion_geometry import _EIGEN_TOLERANCE, FOOTPRINT_SIGMAS, MERGE_SIGMAS, MERGE_SPEED_MPS  # noqa: F401
 from tdm.fusion_geometry import clearly_apart as _clearly_apart
 from tdm.fusion_geometry import inside_reference as _inside_reference
@@ -71,84 +72,6 @@ RELEASE_GATES = 4
 RELEASE_DISTANCES = 2
 #: The order in which the free tracks of each sensor look for a target: AIS (the identity) first.
 SENSOR_ORDER = ("ais", "lidar", "radar")
-
-
-@dataclass(frozen=True)
-class FusionConfig:
-    """Fusion and classification parameters (engineering defaults, unverified)."""
-
-    rule: str = "simple"  # "simple" (thesis eq. 3.2) or "ci" (covariance intersection)
-    min_extent_m: float = 10.0  # smallest absorbing radius of a target, m
-    absorb_lengths: float = 0.75  # absorbing radius in target lengths
-    revive_s: float = 30.0  # a new track where a target ended less than this ago takes its id
-    # ... and where a still target (iceberg, fixed obstacle) ended less than this ago: it is still there when a
-    # weak far echo comes back (busy_open_sea: bergs at 700-1000 m lost by the radar for 60-70 s)
-    revive_still_s: float = 300.0
-    gate_probability: float = 0.9999
-    max_distance_m: float = 60.0
-    vessel_speed_mps: float = 1.0
-    settle_s: float = 20.0
-    iceberg_area_m2: float = 60.0
-    iceberg_height_m: float = 3.0
-    # a still target's (iceberg, fixed obstacle; no AIS) radar track is put this fraction of its size further along
-    # the line of sight: the radar paints a berg's near side and its centre lies behind, about 0.4 of the berg's
-    # size on both busy_open_sea (20-25 m bergs) and rough_sea_rain (19-68 m). The size
-    # (``radar_hidden_depth_size``): "core_width", the running mean of its plots' core width
-    # (Detections.core_width_m, about 0.8 of a berg's size on both, where the plots' extent, cut short by rain and
-    # clutter, is 0.2-0.6); "length", the track's smoothed plot extent (the rule until 2026-11-28, below).
-    # Fitted on busy_open_sea seed 7 (300 s, the tuning scenario), core width: 0.4, 0.45, 0.5, 0.55, 0.6 gave a
-    # median fused error beyond LiDAR range of 4.00, 3.80, 3.69, 3.64, 3.70 m and GOSPA 31.4, 31.4, 31.7, 32.4,
-    # 33.4 m (length, 0.6: 3.63 and 31.3 m): 0.5, with 0.4 x 1.25 behind it (docs/tdm.md, "Extended objects")
-    radar_hidden_depth_fraction: float = 0.5
-    # ... and the uncertainty of that depth, along the line of sight, as a fraction of the same size (0.15, 0.18,
-    # 0.2, 0.25 with 0.5 or 0.45: fused NEES in its interval 0.887-0.895 on the same run)
-    radar_hidden_depth_sigma_fraction: float = 0.2
-    radar_hidden_depth_size: str = "core_width"
-    # ... where the core width spans this many beamwidths at the track's range or more; under it the core width is
-    # ill-conditioned (its slope core/width: a few tenths of a degree of yaw or spoke quantisation move it by tens
-    # of metres: busy_open_sea's 20 m berg at 820 m and crossing_silent_ship's 50 m berg_far at 1.3 km gave 1.6 and
-    # 1.2 times their size, where nearer bergs give 0.6-0.9 of it) and
-    # the length rule below holds. Fitted on busy_open_sea seed 7: 0, 0.3, 0.5, 0.7 gave a median fused error beyond
-    # LiDAR range of 3.69, 3.52, 3.47, 3.59 m and GOSPA 31.7, 31.3, 31.0, 31.1 m
-    radar_core_width_min_beams: float = 0.5
-    # the length rule (the only one until 2026-11-28): this fraction of the track's length (its plots' smoothed
-    # extent, mostly their range extent), fitted on busy_open_sea seed 7 over 0.3-1.3 (median fused error beyond
-    # LiDAR range 5.00, 4.16, 3.72, 3.76, 3.94, 5.47, 7.78, 9.84 m for 0.3, 0.4, 0.5, 0.6, 0.7, 0.9, 1.1, 1.3; the
-    # bergs' median errors smallest at 0.6), with a quarter of the length as the depth's sigma (the bergs' offsets
-    # scattered 2.8 m about their median)
-    radar_hidden_depth_length_fraction: float = 0.6
-    radar_hidden_depth_length_sigma_fraction: float = 0.25
-    # weigh each track in the output with its centre's uncertainty behind the side seen (Track.reported; the
-    # gates and absorbing radii keep the filters' covariances). Off: on busy_open_sea (seed 7, 300 s) it brought
-    # the fused NEES to its ideal (mean 8.3 -> 2.0, in its interval 0.88 -> 0.89) and COG RMSE 5.7 -> 4.8 deg, but
-    # the median error within LiDAR range 2.55 -> 2.91 m and the objects where the fusion beats its best sensor
-    # on every figure 1 -> 0 of 6 (docs/tdm.md)
-    weigh_extent: bool = False
-    # weigh the radar track of a ship whose AIS gives its dimensions with where on its hull it may lie: the radar
-    # tracks the part of the hull it paints (bow, bridge, stern; a fragment of the echo), anywhere along it, so its
-    # offset from the ship's centre is taken as uniform over the hull, variance L^2 / 12 along the course and
-    # B^2 / 12 across (their mean both ways while the course is unknown), added to the radar track's covariance in
-    # the output only (gates and absorbing radii keep the filter's). Not the LiDAR's: within its 100 m it sees the
-    # whole near side. No parameter fitted; on busy_open_sea seed 7 (the tuning run) fused NEES in its interval
-    # 0.867 -> 0.879, median error beyond LiDAR range 3.76 -> 3.72 m, within it 2.63 -> 2.71 m (docs/tdm.md)
-    weigh_hull: bool = True
-    # report each target's covariance with the LiDAR's near-side offset in it: a LiDAR track's centre uncertainty
-    # behind the side seen (Track.extent_var_m2) taken through the fusion's weights as a consider term
-    # (fusion_rules.consider_covariance); the fused state and what the fusion weighs are unchanged
-    consider_lidar_extent: bool = True
-    # a new radar track that joins no target is absorbed by a target within half the radar's cross-range
-    # resolution (this beamwidth at its range) as well as within the target's footprint: the radar cannot
-    # resolve two echoes within a beamwidth at one range; None: the footprint alone
-    radar_beam_deg: float | None = 5.2
-    # report a target without AIS that has absorbed tracks of these sensors at the mean of its member's and those
-    # tracks' positions, their scatter in its covariance (tdm.fusion_weights.with_fragments): a large object's
-    # centre lies among the parts its plots fall on
-    fragment_sensors: tuple[str, ...] = ("radar",)
-
-    def __post_init__(self):
-        if self.radar_hidden_depth_size not in ("core_width", "length"):
-            raise ValueError(f"radar_hidden_depth_size must be 'core_width' or 'length', "
-                             f"not {self.radar_hidden_depth_size!r}")
 
 
 @dataclass
@@ -230,7 +153,9 @@ class Fuser:
             half = self._half_length(target, live)
             target.absorbed = {k for k in target.absorbed if k in live and k not in claimed
                                and self._inside(states[k], x, half)}
+            self._promote(target, states, live, t_s)
             claimed.update(target.absorbed)
+            claimed.update(target.members.items())
         # new or released tracks: join a target without a track of their sensor, else start one
         for sensor in sorted(tracks_by_sensor,
                              key=lambda s: SENSOR_ORDER.index(s) if s in SENSOR_ORDER else len(SENSOR_ORDER)):
@@ -259,7 +184,8 @@ class Fuser:
         out = []
         weigh = with_extent(states, live) if cfg.weigh_extent else states
         if cfg.weigh_hull:
-            weigh = with_hull(weigh, live, self.targets, self.lengths_by_mmsi, self.beams_by_mmsi, VESSEL_SIGMAS)
+            weigh = with_hull(weigh, live, self.targets, self.lengths_by_mmsi, self.beams_by_mmsi, VESSEL_SIGMAS,
+                              cfg.hull_sensors)
         if cfg.fragment_sensors:
             weigh = with_fragments(weigh, self.targets, cfg.fragment_sensors)
         for target in self.targets:
@@ -300,6 +226,35 @@ class Fuser:
         if host is None:
             self.targets.append(self._revive(states[key], t_s) or FusedTarget(next(self._ids), created_s=t_s))
             self.targets[-1].members = {sensor: tr.track_id}
+
+    def _promote(self, target: FusedTarget, states: dict, live: dict, t_s: float) -> None:
+        """An AIS ship's target without a track of a ``join_free_slot`` sensor takes an absorbed track of that sensor
+        as its member once the track is ``promote_after_s`` old and lies on the hull (:meth:`_on_the_hull`)."""
+        if "ais" not in target.members:
+            return
+        for key in sorted(target.absorbed):
+            sensor = key[0]
+            if sensor in self.config.join_free_slot and sensor not in target.members \
+                    and t_s - live[key].created_s >= self.config.promote_after_s \
+                    and self._on_the_hull(sensor, live[key], states, live, target):
+                target.members[sensor] = key[1]
+                target.absorbed.discard(key)
+
+    def _on_the_hull(self, sensor: str, tr: Track, states: dict, live: dict, host: FusedTarget) -> bool:
+        """Whether a track may be on an AIS ship's hull: its velocity not known to differ from the ship's, and its
+        position within the fusion's gate of the AIS track's with the hull's variance added
+        (:func:`tdm.fusion_weights.with_hull`)."""
+        ais_key, key = ("ais", host.members["ais"]), (sensor, tr.track_id)
+        if _moves_apart(states[ais_key], states[key], older_has_ais=True):
+            return False
+        hulled = with_hull({ais_key: states[ais_key], key: states[key]}, live,
+                           [FusedTarget(-1, members={"ais": host.members["ais"], sensor: tr.track_id})],
+                           self.lengths_by_mmsi, self.beams_by_mmsi, VESSEL_SIGMAS, (sensor,))
+        if hulled[key] is states[key]:
+            return False  # the ship's length is not known
+        d = hulled[key][0][:2] - states[ais_key][0][:2]
+        return float(mahalanobis2(d[None, :], (hulled[key][1][:2, :2] + states[ais_key][1][:2, :2])[None])[0]) \
+            <= self._gate
 
     @staticmethod
     def _against(sensor: str, state: tuple, target_estimate: tuple) -> tuple:

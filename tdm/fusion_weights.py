@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from tdm.hull import hull_covariance
+from tdm.hull import BEAM_PER_LENGTH, hull_covariance
 
 __all__ = ["with_extent", "with_fragments", "with_hull"]
 
@@ -30,9 +30,13 @@ def with_extent(states: dict, live: dict) -> dict:
 
 
 def with_hull(states: dict, live: dict, targets: list, lengths_by_mmsi: dict[int, float],
-              beams_by_mmsi: dict[int, float], sigmas: float) -> dict:
+              beams_by_mmsi: dict[int, float], sigmas: float, sensors: tuple[str, ...] = ("radar",)) -> dict:
     """``states`` with the hull's variance (:func:`tdm.hull.hull_covariance`) added to the position covariance of
-    the radar member of every target whose AIS track's MMSI has a known length (``FusionConfig.weigh_hull``).
+    the members of ``sensors`` of every target whose AIS track's MMSI has a known length (``FusionConfig.weigh_hull``).
+
+    A radar track may lie anywhere on the hull (its plots are smeared by the beam); a LiDAR track lies at the middle
+    of the part of the hull it sees, so anywhere on the hull less that part: the hull's length is taken less the
+    LiDAR track's own length (its clusters' smoothed extent), down to nothing.
 
     Parameters
     ----------
@@ -41,20 +45,29 @@ def with_hull(states: dict, live: dict, targets: list, lengths_by_mmsi: dict[int
         AIS static length and beam, m.
     sigmas : float
         Standard deviations of course uncertainty the hull's orientation spans (:func:`hull_covariance`).
+    sensors : tuple of str
+        The sensors whose members are weighed so.
     """
     out = None
     for target in targets:
         ais_key = ("ais", target.members.get("ais", -1))
         length_m = lengths_by_mmsi.get(live[ais_key].mmsi, math.nan) if ais_key in live else math.nan
-        radar_key = ("radar", target.members.get("radar", -1))
-        if radar_key not in live or not math.isfinite(length_m):
+        if not math.isfinite(length_m):
             continue
         x_ais, p_ais = states[ais_key]
-        out = dict(states) if out is None else out
-        x, p = states[radar_key]
-        p = p.copy()
-        p[:2, :2] += hull_covariance(length_m, beams_by_mmsi.get(live[ais_key].mmsi, math.nan), x_ais, p_ais, sigmas)
-        out[radar_key] = (x, p)
+        beam_m = beams_by_mmsi.get(live[ais_key].mmsi, math.nan)
+        for sensor in sensors:
+            key = (sensor, target.members.get(sensor, -1))
+            if key not in live:
+                continue
+            seen_m = live[key].length_m if sensor == "lidar" and math.isfinite(live[key].length_m) else 0.0
+            out = dict(states) if out is None else out
+            x, p = states[key]
+            p = p.copy()
+            p[:2, :2] += hull_covariance(max(length_m - seen_m, 0.0),
+                                         beam_m if math.isfinite(beam_m) else BEAM_PER_LENGTH * length_m,
+                                         x_ais, p_ais, sigmas)
+            out[key] = (x, p)
     return states if out is None else out
 
 

@@ -73,3 +73,44 @@ def test_without_ais_dimensions_or_without_ais_the_radar_weighs_as_its_filter_sa
         (out,) = fuser.step(0.0, tracks)
         assert out.x[1] == pytest.approx(1.5)
         assert out.p[1, 1] == pytest.approx(2.0)
+
+
+def test_an_ais_ships_lidar_track_weighs_with_the_hull_less_the_part_it_sees():
+    """The same ship and a LiDAR track 3 m ahead whose clusters span 60 m of its 100 m: the LiDAR lies at the middle
+    of what it sees, so its north variance is 4 + (100 - 60)^2 / 12; one seeing the whole hull gets the beam's
+    variance across only."""
+    for seen_m, north_extra in ((60.0, 40.0 ** 2 / 12.0), (120.0, 0.0)):
+        fuser = Fuser(FusionConfig())
+        fuser.lengths_by_mmsi, fuser.beams_by_mmsi = {257000001: 100.0}, {257000001: 16.0}
+        ais, lidar = _track(1, "ais", 0.0, mmsi=257000001), _track(2, "lidar", 3.0)
+        lidar.length_m = seen_m
+        (out,) = fuser.step(0.0, {"ais": [ais], "lidar": [lidar]})
+        north_var = 4.0 + north_extra
+        assert out.sources == ["ais", "lidar"]
+        assert out.p[1, 1] == pytest.approx(1.0 / (1.0 / 4.0 + 1.0 / north_var))
+        assert out.p[0, 0] == pytest.approx(1.0 / (1.0 / 4.0 + 1.0 / (4.0 + 16.0 ** 2 / 12.0)))
+
+
+def test_an_absorbed_lidar_track_moving_with_the_ais_ship_becomes_its_member_and_a_still_berg_beside_it_does_not():
+    """crossing_silent_ship: a 60 m ferry's LiDAR track, 20 m off its AIS track across its course (outside the
+    fusion's gate of the two filters' covariances), is absorbed by the ship's footprint, and an absorbed track is not
+    fused. Once it is ``promote_after_s`` old, moves as the ship does and lies on the hull (the gate with the hull's
+    variance), it becomes the target's LiDAR member. A berg's LiDAR track at the same place, known to be still,
+    stays absorbed (busy_open_sea: a berg beside the 100 m research ship)."""
+    for speed_mps, promoted in ((5.0, True), (0.0, False)):
+        fuser = Fuser(FusionConfig())
+        fuser.lengths_by_mmsi, fuser.beams_by_mmsi = {257000112: 60.0}, {257000112: 12.0}
+        ais = _track(1, "ais", 0.0, mmsi=257000112)
+        lidar = _track(2, "lidar", 0.0)
+        lidar.x[:2] = [20.0, 5.0]  # where the ship's hull is at t = 1 s, 20 m east of its AIS track's line
+        lidar.x[ekf.U], lidar.length_m = speed_mps, 15.0
+        lidar.t_s = lidar.created_s = lidar.updated_s = 1.0
+        fuser.step(0.0, {"ais": [ais], "lidar": []})  # the ship's target, from its AIS
+        (first,) = fuser.step(1.0, {"ais": [ais], "lidar": [lidar]})
+        assert first.sources == ["ais"] and ("lidar", 2) in first.target.absorbed
+        assert fuser.config.promote_after_s == 10.0
+        (early,) = fuser.step(10.0, {"ais": [ais], "lidar": [lidar]})
+        assert early.sources == ["ais"]
+        (later,) = fuser.step(11.0, {"ais": [ais], "lidar": [lidar]})
+        assert (later.sources == ["ais", "lidar"]) == promoted
+        assert (("lidar", 2) in later.target.absorbed) == (not promoted)
