@@ -13,8 +13,10 @@
   deviations: the radar beam smears a ship's ends by tens of metres at range) is absorbed:
   it belongs to that target, is not reported and does not enter the fusion. An AIS track is never
   absorbed (it is a ship's identity): inside the footprint of a target without AIS (by the ship's own
-  length when known) whose velocity is not known to differ from the ship's it joins that target;
-  otherwise it starts its own.
+  length when known, plus three standard deviations of both positions) whose velocity is not known to
+  differ from the ship's it joins that target; otherwise it starts its own. An AIS ship's absorbed LiDAR
+  track becomes its member once it moves with the ship and lies on the hull (``promote_after_s``): the
+  LiDAR alone is then often the best position sensor, and an absorbed track is not fused.
 - **Simple Fusion** (thesis eq. 3.2): ``x = (sum_i P_i^-1)^-1 sum_i P_i^-1 x_i`` over the tracks
   of the target at the output time. It ignores the cross-covariance of the per-sensor tracks,
   so its covariance is too small (REFERENCE: NEES about 5.8 against 4); ``tdm evaluate``
@@ -22,7 +24,10 @@
 - **Where on the hull** (``weigh_hull``): a ship's radar track lies on whatever part of the hull the
   radar paints, so for a target whose AIS gives the ship's length, its radar track enters the output
   fusion with the covariance of a point uniform over the hull added (:func:`tdm.hull.hull_covariance`):
-  the fusion leans on the AIS, and its covariance holds the radar's offset.
+  the fusion leans on the AIS, and its covariance holds the radar's offset. Its LiDAR track lies at the
+  middle of the part it sees: uniform over the hull less that part (``hull_sensors``).
+- **Behind the face** (``radar_hidden_depth_*``): a still target's radar track without AIS is put half
+  its plots' core width (or 0.6 of its length where the core width is ill-conditioned) behind its face.
 - **Covariance intersection** (``fusion: ci``), the consistent alternative, with the fast
   weights ``w_i = (1/tr P_i) / sum_j (1/tr P_j)`` (Niehsen 2002):
   ``P^-1 = sum_i w_i P_i^-1``, ``x = P sum_i w_i P_i^-1 x_i``.
