@@ -57,7 +57,7 @@ from tdm.fusion_geometry import clearly_apart as _clearly_apart
 from tdm.fusion_geometry import inside_reference as _inside_reference
 from tdm.fusion_geometry import moves_apart as _moves_apart
 from tdm.fusion_rules import consider_covariance, fuse
-from tdm.fusion_weights import with_extent, with_fragments, with_hull
+from tdm.fusion_weights import member_hull_covariance, with_extent, with_fragments, with_hull
 from tdm.tracker import Track, predicted_at
 
 
@@ -252,14 +252,13 @@ class Fuser:
         ais_key, key = ("ais", host.members["ais"]), (sensor, tr.track_id)
         if _moves_apart(states[ais_key], states[key], older_has_ais=True):
             return False
-        hulled = with_hull({ais_key: states[ais_key], key: states[key]}, live,
-                           [FusedTarget(-1, members={"ais": host.members["ais"], sensor: tr.track_id})],
-                           self.lengths_by_mmsi, self.beams_by_mmsi, VESSEL_SIGMAS, (sensor,))
-        if hulled[key] is states[key]:
+        hull = member_hull_covariance(sensor, tr, live[ais_key], states[ais_key], self.lengths_by_mmsi,
+                                      self.beams_by_mmsi, VESSEL_SIGMAS)
+        if hull is None:
             return False  # the ship's length is not known
-        d = hulled[key][0][:2] - states[ais_key][0][:2]
-        return float(mahalanobis2(d[None, :], (hulled[key][1][:2, :2] + states[ais_key][1][:2, :2])[None])[0]) \
-            <= self._gate
+        d = states[key][0][:2] - states[ais_key][0][:2]
+        s = states[key][1][:2, :2] + hull + states[ais_key][1][:2, :2]
+        return float(mahalanobis2(d[None, :], s[None])[0]) <= self._gate
 
     @staticmethod
     def _against(sensor: str, state: tuple, target_estimate: tuple) -> tuple:
@@ -292,9 +291,9 @@ class Fuser:
         return p + consider_covariance(xs, ps, var, self.config.rule)
 
     def _behind_the_face(self, states: dict, live: dict, own_m: np.ndarray) -> None:
-        """Move the radar tracks of still targets without AIS along the line of sight by
-        ``radar_hidden_depth_fraction`` of their length, with the variance of that depth added along it
-        (``radar_hidden_depth_sigma_fraction``); in ``states``, the tracks themselves untouched."""
+        """Move the radar tracks of still targets without AIS along the line of sight by their hidden depth, with the
+        variance of that depth added along it (:meth:`_hidden_depth_m`); in ``states``, the tracks themselves
+        untouched."""
         for target in self.targets:
             key = ("radar", target.members.get("radar", -1))
             if target.descriptor not in STILL_DESCRIPTORS or "ais" in target.members or key not in states:
@@ -318,8 +317,8 @@ class Fuser:
         if cfg.radar_hidden_depth_size == "core_width" and np.isfinite(core_m) and \
                 core_m >= cfg.radar_core_width_min_beams * distance_m * math.radians(beam_deg or 0.0):
             return cfg.radar_hidden_depth_fraction * core_m, cfg.radar_hidden_depth_sigma_fraction * core_m
-        length_m = track.length_m
-        return cfg.radar_hidden_depth_length_fraction * length_m, cfg.radar_hidden_depth_length_sigma_fraction * length_m
+        return (cfg.radar_hidden_depth_length_fraction * track.length_m,
+                cfg.radar_hidden_depth_length_sigma_fraction * track.length_m)
 
     def _estimate(self, target: FusedTarget, states) -> tuple[np.ndarray, np.ndarray]:
         """The target's fused state (6,) and covariance (6, 6) from its members' ``states``.

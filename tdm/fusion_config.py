@@ -38,18 +38,6 @@ class FusionConfig:
     # 0.2, 0.25 with 0.5 or 0.45: fused NEES in its interval 0.887-0.895 on the same run)
     radar_hidden_depth_sigma_fraction: float = 0.2
     radar_hidden_depth_size: str = "core_width"
-    # an AIS ship's target without a track of these sensors takes an absorbed track of one as its member once the
-    # track is promote_after_s old, its velocity not known to differ from the ship's, and it lies on the hull (the
-    # fusion's gate with the hull's variance, hull_sensors). Absorbed tracks are not fused: crossing_silent_ship's
-    # 60 m ferry was fused from its AIS and radar within LiDAR range, 3.0-3.2 m off, where its LiDAR track alone was
-    # 2.4 m off (it fails the plain gate, 20 m across the AIS track's line). The age lets a berg's LiDAR track beside a
-    # ship learn that it is still (busy_open_sea 32: joined at once, a berg's track took the 100 m research ship's
-    # target 13 m off). 10 s is chosen, not fitted: 5, 10 and 20 s give the same outputs on busy_open_sea seed 7.
-    join_free_slot: tuple[str, ...] = ("lidar",)
-    promote_after_s: float = 10.0
-    # the members weighed by where on an AIS ship's hull they may lie (tdm.fusion_weights.with_hull): the radar's
-    # anywhere on it, the LiDAR's anywhere less the part it sees
-    hull_sensors: tuple[str, ...] = ("radar", "lidar")
     # ... where the core width spans this many beamwidths at the track's range or more; under it the core width is
     # ill-conditioned (its slope core/width: a few tenths of a degree of yaw or spoke quantisation move it by tens
     # of metres: busy_open_sea's 20 m berg at 820 m and crossing_silent_ship's 50 m berg_far at 1.3 km gave 1.6 and
@@ -64,6 +52,18 @@ class FusionConfig:
     # scattered 2.8 m about their median)
     radar_hidden_depth_length_fraction: float = 0.6
     radar_hidden_depth_length_sigma_fraction: float = 0.25
+    # an AIS ship's target without a track of these sensors takes an absorbed track of one as its member once the
+    # track is promote_after_s old, its velocity not known to differ from the ship's, and it lies on the hull (the
+    # fusion's gate with the hull's variance, hull_sensors). Absorbed tracks are not fused: crossing_silent_ship's
+    # 60 m ferry was fused from its AIS and radar within LiDAR range, 3.0-3.2 m off, where its LiDAR track alone was
+    # 2.4 m off (it fails the plain gate, 20 m across the AIS track's line). The age lets a berg's LiDAR track beside a
+    # ship learn that it is still (busy_open_sea 32: joined at once, a berg's track put the 100 m research ship's
+    # target 13-15 m off). 10 s is chosen, not fitted: 5, 10 and 20 s give the same outputs on busy_open_sea seed 7.
+    join_free_slot: tuple[str, ...] = ("lidar",)
+    promote_after_s: float = 10.0
+    # the members weighed by where on an AIS ship's hull they may lie (tdm.fusion_weights.with_hull): the radar's
+    # anywhere on it, the LiDAR's anywhere less the part it sees
+    hull_sensors: tuple[str, ...] = ("radar", "lidar")
     # weigh each track in the output with its centre's uncertainty behind the side seen (Track.reported; the
     # gates and absorbing radii keep the filters' covariances). Off: on busy_open_sea (seed 7, 300 s) it brought
     # the fused NEES to its ideal (mean 8.3 -> 2.0, in its interval 0.88 -> 0.89) and COG RMSE 5.7 -> 4.8 deg, but
@@ -74,9 +74,11 @@ class FusionConfig:
     # tracks the part of the hull it paints (bow, bridge, stern; a fragment of the echo), anywhere along it, so its
     # offset from the ship's centre is taken as uniform over the hull, variance L^2 / 12 along the course and
     # B^2 / 12 across (their mean both ways while the course is unknown), added to the radar track's covariance in
-    # the output only (gates and absorbing radii keep the filter's). Not the LiDAR's: within its 100 m it sees the
-    # whole near side. No parameter fitted; on busy_open_sea seed 7 (the tuning run) fused NEES in its interval
-    # 0.867 -> 0.879, median error beyond LiDAR range 3.76 -> 3.72 m, within it 2.63 -> 2.71 m (docs/tdm.md)
+    # the output only (gates and absorbing radii keep the filter's); a LiDAR member likewise, over the hull less the
+    # part it sees (hull_sensors, since 2026-11-28; it had been left out as seeing the whole near side, but
+    # crossing_silent_ship's 60 m ferry's LiDAR track sees less than 18 m of it). No parameter fitted; for the radar
+    # on busy_open_sea seed 7 (the tuning run) fused NEES in its interval 0.867 -> 0.879, median error beyond LiDAR
+    # range 3.76 -> 3.72 m, within it 2.63 -> 2.71 m (docs/tdm.md)
     weigh_hull: bool = True
     # report each target's covariance with the LiDAR's near-side offset in it: a LiDAR track's centre uncertainty
     # behind the side seen (Track.extent_var_m2) taken through the fusion's weights as a consider term

@@ -13,7 +13,7 @@ import numpy as np
 
 from tdm.hull import BEAM_PER_LENGTH, hull_covariance
 
-__all__ = ["with_extent", "with_fragments", "with_hull"]
+__all__ = ["member_hull_covariance", "with_extent", "with_fragments", "with_hull"]
 
 
 def with_extent(states: dict, live: dict) -> dict:
@@ -51,24 +51,46 @@ def with_hull(states: dict, live: dict, targets: list, lengths_by_mmsi: dict[int
     out = None
     for target in targets:
         ais_key = ("ais", target.members.get("ais", -1))
-        length_m = lengths_by_mmsi.get(live[ais_key].mmsi, math.nan) if ais_key in live else math.nan
-        if not math.isfinite(length_m):
+        if ais_key not in live:
             continue
-        x_ais, p_ais = states[ais_key]
-        beam_m = beams_by_mmsi.get(live[ais_key].mmsi, math.nan)
         for sensor in sensors:
             key = (sensor, target.members.get(sensor, -1))
             if key not in live:
                 continue
-            seen_m = live[key].length_m if sensor == "lidar" and math.isfinite(live[key].length_m) else 0.0
+            hull = member_hull_covariance(sensor, live[key], live[ais_key], states[ais_key], lengths_by_mmsi,
+                                          beams_by_mmsi, sigmas)
+            if hull is None:
+                break  # the ship's length is not known
             out = dict(states) if out is None else out
             x, p = states[key]
             p = p.copy()
-            p[:2, :2] += hull_covariance(max(length_m - seen_m, 0.0),
-                                         beam_m if math.isfinite(beam_m) else BEAM_PER_LENGTH * length_m,
-                                         x_ais, p_ais, sigmas)
+            p[:2, :2] += hull
             out[key] = (x, p)
     return states if out is None else out
+
+
+def member_hull_covariance(sensor: str, member, ais_track, ais_state: tuple, lengths_by_mmsi: dict[int, float],
+                           beams_by_mmsi: dict[int, float], sigmas: float) -> np.ndarray | None:
+    """(2, 2) east-north covariance of where on an AIS ship's hull a member track of ``sensor`` may lie, m^2
+    (:func:`with_hull`); None when the ship's length is not known.
+
+    Parameters
+    ----------
+    sensor : str
+    member, ais_track : Track
+        The member track (a LiDAR track's ``length_m`` is the part of the hull it sees) and the ship's AIS track.
+    ais_state : tuple of (6,) and (6, 6) float
+        The AIS track's state and covariance (its course orients the hull).
+    lengths_by_mmsi, beams_by_mmsi : dict of int to float
+    sigmas : float
+    """
+    length_m = lengths_by_mmsi.get(ais_track.mmsi, math.nan)
+    if not math.isfinite(length_m):
+        return None
+    beam_m = beams_by_mmsi.get(ais_track.mmsi, math.nan)
+    seen_m = member.length_m if sensor == "lidar" and math.isfinite(member.length_m) else 0.0
+    return hull_covariance(max(length_m - seen_m, 0.0), beam_m if math.isfinite(beam_m) else BEAM_PER_LENGTH * length_m,
+                           ais_state[0], ais_state[1], sigmas)
 
 
 def with_fragments(states: dict, targets: list, sensors: tuple[str, ...] = ("radar",)) -> dict:

@@ -350,20 +350,18 @@ def _centroids(plots: _Plots, power: np.ndarray, range_m: np.ndarray, azimuth_de
     return plot_range_m, bearing_rel_deg
 
 
-def _extents(plots: _Plots, power: np.ndarray, azimuth_deg: np.ndarray, bearing_rel_deg: np.ndarray,
-             plot_range_m: np.ndarray, spacing_m: float, n_spokes: int, config: RadarFrontEndConfig
-             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _extents(plots: _Plots, d_az: np.ndarray, power_max: np.ndarray, power_min: np.ndarray, plot_range_m: np.ndarray,
+             spacing_m: float, n_spokes: int, config: RadarFrontEndConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(m,) range extent Lr (m), cross-range extent Lc (m) and beam fill of each plot, less the smear of
-    the range point-spread and of the beam (:func:`radar_detections`)."""
+    the range point-spread and of the beam (:func:`radar_detections`); ``d_az`` (M,) each cell's azimuth from its
+    plot's bearing, deg, ``power_max``, ``power_min`` (m,) each plot's strongest and weakest cell's power."""
     lab = plots.label
-    d_az = _wrap_deg(azimuth_deg[plots.spoke] - bearing_rel_deg[lab])
     spoke_deg = 360.0 / n_spokes
     az_max, az_min = _label_max_min(d_az, lab, plots.n)
     extent_az_deg = az_max - az_min + spoke_deg
     sample_max, sample_min = _label_max_min(plots.sample, lab, plots.n)
     extent_r_m = (sample_max - sample_min + 1) * spacing_m
     # log2 of the plot's power ratio, strongest to weakest cell
-    power_max, power_min = _label_max_min(power, lab, plots.n)
     dynamic_log2 = np.log2(np.maximum(power_max / power_min, 1.0))
     len_r_m = np.maximum(extent_r_m - config.range_resolution_m * np.sqrt(dynamic_log2), spacing_m)
     beam_smear_deg = config.beam_az_deg * np.sqrt(dynamic_log2 / TWO_WAY)
@@ -372,16 +370,15 @@ def _extents(plots: _Plots, power: np.ndarray, azimuth_deg: np.ndarray, bearing_
     return len_r_m, len_c_m, beam_fill
 
 
-def _core_widths(plots: _Plots, power: np.ndarray, azimuth_deg: np.ndarray, bearing_rel_deg: np.ndarray,
-                 plot_range_m: np.ndarray, n_spokes: int, config: RadarFrontEndConfig) -> np.ndarray:
+def _core_widths(plots: _Plots, power: np.ndarray, d_az: np.ndarray, power_max: np.ndarray, plot_range_m: np.ndarray,
+                 n_spokes: int, config: RadarFrontEndConfig) -> np.ndarray:
     """(m,) cross-range width of each plot's core, m: the azimuth extent of its cells within ``core_db`` of its
     strongest, less in quadrature the width the two-way Gaussian beam paints down to ``core_db``
-    (``theta3 sqrt(core_db / 6.02)``), times its range; 0 where the core is no wider than the beam."""
+    (``theta3 sqrt(core_db / 6.02)``), times its range; 0 where the core is no wider than the beam. ``d_az`` and
+    ``power_max`` as for :func:`_extents`."""
     lab = plots.label
-    power_max = _label_max_min(power, lab, plots.n)[0]
     core = power >= power_max[lab] * 10.0 ** (-config.core_db / 10.0)
-    d_az = _wrap_deg(azimuth_deg[plots.spoke[core]] - bearing_rel_deg[lab[core]])
-    az_max, az_min = _label_max_min(d_az, lab[core], plots.n)
+    az_max, az_min = _label_max_min(d_az[core], lab[core], plots.n)
     core_deg = az_max - az_min + 360.0 / n_spokes
     beam_deg = config.beam_az_deg * np.sqrt(config.core_db / TWO_WAY_HALF_POWER_DB)
     return plot_range_m * np.radians(np.sqrt(np.maximum(core_deg ** 2 - beam_deg ** 2, 0.0)))
@@ -510,8 +507,9 @@ def radar_detections(sweep: dict, track: OwnshipTrack, mount: Mount, config: Rad
     power = video_power(echo[plots.spoke, plots.sample], config).astype(np.float64)
     spacing_m = float(np.median(np.diff(range_m))) if n_samples > 1 else _ONE_SAMPLE_SPACING_M
     plot_range_m, bearing_rel_deg = _centroids(plots, power, range_m, azimuth_deg)
-    len_r, len_c, beam_fill = _extents(plots, power, azimuth_deg, bearing_rel_deg, plot_range_m, spacing_m,
-                                       n_spokes, config)
+    d_az = _wrap_deg(azimuth_deg[plots.spoke] - bearing_rel_deg[plots.label])  # each cell's, from its plot's bearing
+    power_max, power_min = _label_max_min(power, plots.label, plots.n)
+    len_r, len_c, beam_fill = _extents(plots, d_az, power_max, power_min, plot_range_m, spacing_m, n_spokes, config)
     t_plot, u, position = _plot_positions(bearing_rel_deg, plot_range_m, azimuth_deg, heading_deg, time_s, track,
                                           mount)
     k = _off_ship(bearing_rel_deg, plot_range_m, mount, config)
@@ -525,7 +523,7 @@ def radar_detections(sweep: dict, track: OwnshipTrack, mount: Mount, config: Rad
         height_m=np.full(int(np.count_nonzero(k)), np.nan),
         n_cells=np.bincount(plots.label, minlength=plots.n).astype(np.int64)[k], range_m=plot_range_m[k],
         strength_db=plots.margin_db[k], beam_fill=beam_fill[k],
-        core_width_m=_core_widths(plots, power, azimuth_deg, bearing_rel_deg, plot_range_m, n_spokes, config)[k])
+        core_width_m=_core_widths(plots, power, d_az, power_max, plot_range_m, n_spokes, config)[k])
 
 
 def _sweep_land_blocks(land: LandMask | None, azimuth_deg: np.ndarray, heading_deg: np.ndarray, time_s: np.ndarray,
