@@ -4,7 +4,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["FusionConfig"]
+__all__ = ["FusionConfig", "TRACK_SENSORS"]
+
+#: The sensors whose tracks a target's members are, besides its AIS track.
+TRACK_SENSORS = ("lidar", "radar")
 
 
 @dataclass(frozen=True)
@@ -97,3 +100,9 @@ class FusionConfig:
         if self.radar_hidden_depth_size not in ("core_width", "length"):
             raise ValueError(f"radar_hidden_depth_size must be 'core_width' or 'length', "
                              f"not {self.radar_hidden_depth_size!r}")
+        for name in ("join_free_slot", "hull_sensors", "fragment_sensors"):
+            unknown = sorted(set(getattr(self, name)) - set(TRACK_SENSORS))
+            if unknown:
+                raise ValueError(f"{name}: unknown sensor {unknown[0]!r} (one of {', '.join(TRACK_SENSORS)})")
+        if not self.promote_after_s >= 0.0:
+            raise ValueError(f"promote_after_s must be >= 0, not {self.promote_after_s}")

@@ -107,6 +107,15 @@ def test_the_hidden_depth_is_a_fraction_of_the_core_width_where_the_object_spans
         FusionConfig(radar_hidden_depth_size="width")
 
 
+@pytest.mark.parametrize("field", ["join_free_slot", "hull_sensors", "fragment_sensors"])
+def test_a_misspelt_sensor_in_a_fusion_setting_is_an_error_not_a_rule_quietly_off(field):
+    with pytest.raises(ValueError, match=f"{field}: unknown sensor 'lider'"):
+        FusionConfig(**{field: ("lider",)})
+    with pytest.raises(ValueError, match="promote_after_s"):
+        FusionConfig(promote_after_s=float("nan"))
+    assert getattr(FusionConfig(**{field: ()}), field) == ()
+
+
 def test_an_ais_track_joins_a_new_radar_target_within_the_ships_length_and_both_uncertainties():
     """busy_port seed 32: a 30 m ferry's first AIS report lies 36 m from the radar target started on it a second
     before (its first plots, 370 m off: metres of cross-range uncertainty); judged by the AIS track's covariance
