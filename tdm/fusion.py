@@ -10,7 +10,8 @@
   iceberg several LiDAR clusters, hence several tracks of one sensor. A track that joins no
   target but lies near the footprint of a target (within ``absorb_lengths`` (0.75) of its length,
   known from AIS static data or from its tracks' measured extents, plus three standard
-  deviations: the radar beam smears a ship's ends by tens of metres at range) is absorbed:
+  deviations: the radar beam smears a ship's ends by tens of metres at range; for a radar track, plus half
+  the beam's cross-range resolution at its range) is absorbed:
   it belongs to that target, is not reported and does not enter the fusion. An AIS track is never
   absorbed (it is a ship's identity): inside the footprint of a target without AIS (by the ship's own
   length when known, plus three standard deviations of both positions) whose velocity is not known to
@@ -206,8 +207,8 @@ class Fuser:
 
     def _place(self, sensor: str, tr: Track, states: dict, live: dict, t_s: float,
                own_position_m: np.ndarray | None) -> None:
-        """A track that joined no target: absorbed by a target whose footprint (or, for radar, the beam's
-        resolution) holds it; an AIS track instead joins such a target without AIS whose velocity is not known
+        """A track that joined no target: absorbed by a target whose footprint (for radar, widened by half the
+        beam's resolution: :meth:`_beyond_size`) holds it; an AIS track instead joins such a target without AIS whose velocity is not known
         to differ (by the ship's own length when known, or half the radar's resolution at the target's range if
         larger, as :meth:`_merge_radius` would merge them), as the ship's identity never hides in a target;
         otherwise a new target, or a recently ended one revived."""
@@ -219,7 +220,7 @@ class Fuser:
                                       centre := est[0],
                                       max(ship_m, self._unresolved_m("radar" if "radar" in t.members else "", centre,
                                                                      own_position_m))
-                                      if math.isfinite(ship_m) else max(self._half_length(t, live), unresolved_m))),
+                                      if math.isfinite(ship_m) else self._beyond_size(self._half_length(t, live), unresolved_m))),
                     None)
         if host is not None and sensor == "ais":
             if _moves_apart(self._estimate(host, states), states[key], older_has_ais=False):
@@ -270,6 +271,13 @@ class Fuser:
         p = p.copy()
         p[:2, :2] = p[:2, :2] + target_estimate[1][:2, :2]
         return x, p
+
+    def _beyond_size(self, half_length_m: float, unresolved_m: float) -> float:
+        """A new track's absorbing radius about a target: the target's radius and the beam's half resolution summed
+        (``radar_smear_beyond_size``: the echo of an object spans its size smeared by the beam) or the larger."""
+        if self.config.radar_smear_beyond_size:
+            return half_length_m + unresolved_m
+        return max(half_length_m, unresolved_m)
 
     def _unresolved_m(self, sensor: str, x: np.ndarray, own_position_m: np.ndarray | None) -> float:
         """Half the radar's cross-range resolution at the track's range, m (``radar_beam_deg``); 0 otherwise."""

@@ -382,13 +382,17 @@ def test_the_lidars_near_side_offset_is_reported_in_the_covariance_not_the_state
     assert out.p[0, 0] == pytest.approx(1.0 / 1.25 + (9.0 * 0.8 ** 2 if consider else 0.0))
 
 
-@pytest.mark.parametrize("across_m, own, absorbed", [
-    (22.0, True, True),    # inside half a beamwidth at 600 m (27.2 m), outside the 10 m footprint + 3 sigma (16 m)
-    (35.0, True, False),   # resolved: a new target
-    (22.0, False, False),  # without the own ship's position: the footprint alone
+@pytest.mark.parametrize("across_m, own, smear, absorbed", [
+    # half a beamwidth at 600 m is 27.2 m; the target's footprint 10 m (min_extent_m); 3 sigma 6 m
+    (22.0, True, False, True),    # within the larger of the two (27.2 m + 3 sigma)
+    (30.0, True, False, True),
+    (40.0, True, False, False),   # resolved: a new target
+    (40.0, True, True, True),     # within their sum (37.2 m + 3 sigma): the object's echo smeared by the beam
+    (45.0, True, True, False),
+    (22.0, False, True, False),   # without the own ship's position: the footprint alone
 ])
-def test_a_new_radar_track_within_the_beams_resolution_of_a_target_is_absorbed(across_m, own, absorbed):
-    config = FusionConfig()
+def test_a_new_radar_track_within_the_beams_resolution_of_a_target_is_absorbed(across_m, own, smear, absorbed):
+    config = FusionConfig(radar_smear_beyond_size=smear)
     fuser = Fuser(config)
     own_m = np.array([0.0, 0.0]) if own else None
     first = make_track(1, "radar", 0.0, 600.0, var=4.0)
@@ -399,7 +403,6 @@ def test_a_new_radar_track_within_the_beams_resolution_of_a_target_is_absorbed(a
     assert 0.5 * 600.0 * np.radians(config.radar_beam_deg) == pytest.approx(27.2, abs=0.05)
     lidar = make_track(3, "lidar", -across_m, 600.0, var=4.0)  # the rule is the radar's: a LiDAR track is resolved
     assert len(fuser.step(3.0, {"radar": [first, second], "lidar": [lidar]}, own_m)) == len(out) + 1
-
 
 
 def test_an_ais_track_is_never_absorbed():
