@@ -504,7 +504,9 @@ class Fuser:
         """Release members that have drifted away from the target's other tracks.
 
         An AIS track is the target's identity: when there is one, the other members are checked
-        against it and released if inconsistent; the AIS track itself is never released.
+        against it and released if inconsistent; the AIS track itself is never released. Without one,
+        each member is checked against the fusion of the others, the least precise first
+        (``release_least_precise``; else in the order they joined), and the first found inconsistent leaves.
         """
         if "ais" in target.members:
             ais_key = ("ais", target.members["ais"])
@@ -516,6 +518,8 @@ class Fuser:
                     del target.members[key[0]]
             return
         keys = list(target.members.items())
+        if self.config.release_least_precise:  # the widest first: of two that disagree, the better one stays
+            keys.sort(key=lambda k: -float(np.trace(states[k][1][:2, :2])))
         for key in keys:
             others = [k for k in target.members.items() if k != key]
             if not others:

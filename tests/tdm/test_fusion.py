@@ -436,3 +436,22 @@ def test_a_target_swollen_by_sidelobes_does_not_take_an_ais_ship_beyond_that_shi
         assert len(out) == 2 and sorted(e.sources for e in out) == [["ais"], ["radar"]]
         (pier_out,) = [e for e in out if e.sources == ["radar"]]
         assert pier_out.target.target_id == first.target.target_id and not pier_out.target.absorbed
+
+
+@pytest.mark.parametrize("least_precise", [True, False])
+def test_of_two_members_that_disagree_the_less_precise_leaves_and_the_target_keeps_the_better(least_precise):
+    """A boat's LiDAR track (sd 2 m) and a radar track (sd 20 m) that joined its target and then lies 130 m away
+    (beyond twice max_distance_m): with ``release_least_precise`` the radar track leaves and the target keeps its id
+    with the LiDAR track; otherwise the LiDAR track, checked first as it joined first, leaves under a new id."""
+    fuser = Fuser(FusionConfig(release_least_precise=least_precise))
+    lidar = make_track(1, "lidar", 0.0, 0.0, var=4.0)
+    (first,) = fuser.step(0.0, {"lidar": [lidar]})
+    radar = make_track(2, "radar", 3.0, 0.0, var=400.0)
+    (joined,) = fuser.step(1.0, {"lidar": [lidar], "radar": [radar]})
+    assert joined.target.target_id == first.target.target_id and joined.sources == ["lidar", "radar"]
+    radar.x[0] = 130.0
+    out = fuser.step(2.0, {"lidar": [lidar], "radar": [radar]})
+    by_sources = {tuple(e.sources): e.target.target_id for e in out}
+    assert set(by_sources) == {("lidar",), ("radar",)}
+    kept = ("lidar",) if least_precise else ("radar",)
+    assert by_sources[kept] == first.target.target_id
