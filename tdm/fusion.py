@@ -152,7 +152,7 @@ class Fuser:
             if not target.members and target.last_x is not None:
                 self._ended.append(target)
         self._ended = [t for t in self._ended if t_s - t.last_t_s <= (
-            cfg.revive_still_s if t.descriptor in STILL_DESCRIPTORS else cfg.revive_s)]
+            cfg.revive_still_s if self._ended_still(t) else cfg.revive_s)]
         self.targets = [t for t in self.targets if t.members]
         for target in self.targets:
             x, _ = self._estimate(target, states)
@@ -403,12 +403,23 @@ class Fuser:
                 return False
         return _inside_reference(state, centre, half_length_m)
 
+    def _ended_still(self, target: FusedTarget) -> bool:
+        """Whether an ended target is looked for where it was for ``revive_still_s``: settled as still (iceberg,
+        fixed obstacle), or (``revive_slow_as_still``) without AIS, not a vessel, and last reported slower than still
+        targets are (STILL_SPEED_FRACTION of ``vessel_speed_mps``; the filter's speed may be negative, its course then
+        reversed), before it had lived long enough to settle."""
+        if target.descriptor in STILL_DESCRIPTORS:
+            return True
+        return self.config.revive_slow_as_still and target.mmsi is None and target.descriptor != "vessel" \
+            and target.last_x is not None \
+            and abs(float(target.last_x[ekf.U])) < STILL_SPEED_FRACTION * self.config.vessel_speed_mps
+
     def _revive(self, state, t_s: float) -> FusedTarget | None:
         """The recently ended target whose footprint (its last state predicted to ``t_s``) holds ``state``."""
         best, best_d = None, np.inf
         for target in self._ended:
             # a still target is where it was: its last small speed (drift of a noisy track) is not carried on
-            centre = target.last_x if target.descriptor in STILL_DESCRIPTORS else \
+            centre = target.last_x if self._ended_still(target) else \
                 ekf.predict_mean(target.last_x, t_s - target.last_t_s)
             if self._inside(state, centre, target.radius_m):
                 d = float(np.hypot(*(state[0][:2] - centre[:2])))
@@ -514,7 +525,8 @@ class Fuser:
             for key in [k for k in target.members.items() if k[0] != "ais"]:
                 xi, pi_ = states[key]
                 d = xi[:2] - xa[:2]
-                if self._released(d, pi_[:2, :2] + pa[:2, :2]):
+                moving = self.config.release_beyond_ais_spread and abs(xa[ekf.U]) > self.config.vessel_speed_mps
+                if self._released(d, pi_[:2, :2] + pa[:2, :2], pa[:2, :2] if moving else None):
                     del target.members[key[0]]
             return
         keys = list(target.members.items())
@@ -532,9 +544,15 @@ class Fuser:
             if self._released(d, pi_[:2, :2] + p[:2, :2]):
                 del target.members[key[0]]
 
-    def _released(self, d: np.ndarray, s: np.ndarray) -> bool:
-        """A member at position difference ``d`` (m, 2) with summed covariance ``s`` (m^2) leaves its target."""
-        return mahalanobis2(d, s) > RELEASE_GATES * self._gate or np.hypot(*d) > RELEASE_DISTANCES * self.config.max_distance_m
+    def _released(self, d: np.ndarray, s: np.ndarray, spread: np.ndarray | None = None) -> bool:
+        """A member at position difference ``d`` (m, 2) with summed covariance ``s`` (m^2) leaves its target: beyond
+        RELEASE_GATES gates, or RELEASE_DISTANCES x ``max_distance_m`` plus FOOTPRINT_SIGMAS standard deviations of
+        ``spread`` (m^2; the AIS track's own covariance, its coast between reports) along its major axis."""
+        limit_m = RELEASE_DISTANCES * self.config.max_distance_m
+        if spread is not None:
+            a, b, c = float(spread[0, 0]), float(spread[1, 0]), float(spread[1, 1])
+            limit_m += FOOTPRINT_SIGMAS * math.sqrt(max(0.5 * (a + c) + math.hypot(0.5 * (a - c), b), 0.0))
+        return mahalanobis2(d, s) > RELEASE_GATES * self._gate or np.hypot(*d) > limit_m
 
     def _classify(self, target: FusedTarget, x: np.ndarray, p: np.ndarray, t_s: float, height_m: float) -> None:
         cfg = self.config

@@ -21,6 +21,10 @@ class FusionConfig:
     # ... and where a still target (iceberg, fixed obstacle) ended less than this ago: it is still there when a
     # weak far echo comes back (busy_open_sea: bergs at 700-1000 m lost by the radar for 60-70 s)
     revive_still_s: float = 300.0
+    # ... also for a target without AIS last reported slower than a still one (half vessel_speed_mps) that ended before
+    # it had settled (settle_s): rough_sea_rain 32's growler, painted by the radar for 7-8 s at a time a minute apart,
+    # took a new id each time
+    revive_slow_as_still: bool = True
     gate_probability: float = 0.9999
     max_distance_m: float = 60.0
     vessel_speed_mps: float = 1.0
@@ -105,6 +109,14 @@ class FusionConfig:
     # radar track of sea clutter 50 m off the bow took a boat's target, and its LiDAR track, 2-8 m off it, left
     # under a new id twice)
     release_least_precise: bool = True
+    # a member leaves a moving AIS ship's target (speed over vessel_speed_mps) beyond twice max_distance_m plus three
+    # standard deviations of the AIS track's own position (its coast since the last report), not twice max_distance_m
+    # alone: busy_port 34's class B boat's AIS track, 31 s after its last report, extrapolated a turn 122 m off (sd
+    # 87 m) and its radar track, 1.5 m off the boat, left under a new id for 2 s. A ship at anchor or moored is not
+    # moving off its report: with its 3-minute reports the spread held the pier's radar fragments in
+    # harbour_approach's anchored and moored ships' targets (seed 31's error beyond LiDAR range 6.7 -> 8.7 m). Both
+    # found on held-out runs (docs/tdm.md)
+    release_beyond_ais_spread: bool = True
 
     def __post_init__(self):
         if self.radar_hidden_depth_size not in ("core_width", "length"):

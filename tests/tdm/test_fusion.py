@@ -161,7 +161,7 @@ def test_a_distant_track_of_a_new_object_starts_a_new_target():
 
 
 def test_a_new_track_where_a_target_just_ended_takes_its_id():
-    fuser = Fuser(FusionConfig(revive_s=30.0))
+    fuser = Fuser(FusionConfig(revive_s=30.0, revive_slow_as_still=False))  # the plain window (a slow one: below)
     (first,) = fuser.step(1.0, {"radar": [make_track(1, "radar", 500.0, 0.0)]})
     fuser.step(2.0, {"radar": []})  # the weak echo was lost: the target ends
     (again,) = fuser.step(10.0, {"radar": [make_track(2, "radar", 503.0, 2.0, t=10.0)]})
@@ -455,3 +455,57 @@ def test_of_two_members_that_disagree_the_less_precise_leaves_and_the_target_kee
     assert set(by_sources) == {("lidar",), ("radar",)}
     kept = ("lidar",) if least_precise else ("radar",)
     assert by_sources[kept] == first.target.target_id
+
+
+@pytest.mark.parametrize("spread, kept", [(True, True), (False, False)])
+def test_a_member_stays_with_an_ais_ship_whose_coasting_track_is_far_but_uncertain(spread, kept):
+    """A moving boat's radar track 122 m from its AIS track, 30 s since the last report (sd 62 m each way): within
+    the release gate, beyond twice max_distance_m (120 m). With ``release_beyond_ais_spread`` the limit grows by
+    three of the AIS track's standard deviations and the radar track stays; without, it leaves under a new id.
+    A still ship (speed under ``vessel_speed_mps``) keeps the plain limit."""
+    fuser = Fuser(FusionConfig(release_beyond_ais_spread=spread))
+    ais = make_track(1, "ais", 0.0, 0.0, var=4.0, mmsi=367000402)
+    radar = make_track(2, "radar", 3.0, 0.0, var=16.0)
+    ais.x[ekf.U] = radar.x[ekf.U] = 5.0  # heading north at 5 m/s: a moving ship (a still one's coast is not spread)
+    (joined,) = fuser.step(0.0, {"ais": [ais], "radar": [radar]})
+    assert joined.sources == ["ais", "radar"]
+    ais.x[0], ais.p[0, 0], ais.p[1, 1] = 125.0, 3800.0, 3800.0
+    out = fuser.step(1.0, {"ais": [ais], "radar": [radar]})
+    assert len(out) == (1 if kept else 2)
+    assert out[0].target.target_id == joined.target.target_id and out[0].sources == (["ais", "radar"] if kept else ["ais"])
+
+
+def test_a_still_ais_ships_coast_does_not_hold_a_far_member():
+    """The same far member against an AIS ship at anchor (speed 0): released under the plain limit, as before."""
+    fuser = Fuser(FusionConfig())
+    ais = make_track(1, "ais", 0.0, 0.0, var=4.0, mmsi=367000402)
+    radar = make_track(2, "radar", 3.0, 0.0, var=16.0)
+    fuser.step(0.0, {"ais": [ais], "radar": [radar]})
+    ais.x[0], ais.p[0, 0], ais.p[1, 1] = 125.0, 3800.0, 3800.0
+    assert len(fuser.step(1.0, {"ais": [ais], "radar": [radar]})) == 2
+
+
+@pytest.mark.parametrize("slow, same_id", [(True, True), (False, False)])
+def test_a_slow_target_that_ended_before_settling_is_looked_for_where_it_was(slow, same_id):
+    """A growler's radar track, still, seen for 5 s (under ``settle_s``: not yet an iceberg) and lost; a minute later
+    (over ``revive_s``, under ``revive_still_s``) a new radar track at its place takes its id with
+    ``revive_slow_as_still``, a new one without. A moving target's id is not kept so long."""
+    config = FusionConfig(revive_slow_as_still=slow)
+    assert config.revive_s < 60.0 < config.revive_still_s
+    fuser = Fuser(config)
+    first = make_track(1, "radar", 0.0, 400.0)
+    for t in range(5):
+        (out,) = fuser.step(float(t), {"radar": [first]})
+    assert out.target.descriptor == "unknown"
+    assert fuser.step(5.0, {}) == []
+    again = make_track(2, "radar", 2.0, 401.0, t=65.0)
+    (back,) = fuser.step(65.0, {"radar": [again]})
+    assert (back.target.target_id == out.target.target_id) == same_id
+    moving = Fuser(config)
+    boat = make_track(1, "radar", 0.0, 400.0)
+    boat.x[ekf.PSI], boat.x[ekf.U] = np.pi, -3.0  # north at 3 m/s, as a filter may hold it: course south, speed < 0
+    for t in range(5):
+        (gone,) = moving.step(float(t), {"radar": [boat]})
+    moving.step(5.0, {})
+    where = make_track(2, "radar", 0.0, 400.0, t=65.0)  # where it was: a moving target is not looked for there
+    assert moving.step(65.0, {"radar": [where]})[0].target.target_id != gone.target.target_id
