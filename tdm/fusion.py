@@ -80,6 +80,11 @@ RELEASE_DISTANCES = 2
 SENSOR_ORDER = ("ais", "lidar", "radar")
 
 
+def _finite_or_inf(value: float) -> float:
+    """``value``, or +inf where it is not finite (NaN sorts nowhere)."""
+    return value if math.isfinite(value) else math.inf
+
+
 @dataclass
 class FusedTarget:
     """A detected target: the per-sensor tracks of one object."""
@@ -407,7 +412,8 @@ class Fuser:
         """Whether an ended target is looked for where it was for ``revive_still_s``: settled as still (iceberg,
         fixed obstacle), or (``revive_slow_as_still``) without AIS, not a vessel, and last reported slower than still
         targets are (STILL_SPEED_FRACTION of ``vessel_speed_mps``; the filter's speed may be negative, its course then
-        reversed), before it had lived long enough to settle."""
+        reversed): one that ended before it settled, its speed's uncertainty not asked (a boat lost two seconds
+        after its first plot, its speed still about its prior 0, is kept so too, where it was)."""
         if target.descriptor in STILL_DESCRIPTORS:
             return True
         return self.config.revive_slow_as_still and target.mmsi is None and target.descriptor != "vessel" \
@@ -516,22 +522,23 @@ class Fuser:
 
         An AIS track is the target's identity: when there is one, the other members are checked
         against it and released if inconsistent; the AIS track itself is never released. Without one,
-        each member is checked against the fusion of the others, the least precise first
-        (``release_least_precise``; else in the order they joined), and the first found inconsistent leaves.
+        each member is checked in turn against the fusion of the others still in it, the least precise first
+        (``release_least_precise``, a non-finite variance counting as the least; else in the order they joined),
+        and each found inconsistent leaves: of two that disagree, the first checked.
         """
         if "ais" in target.members:
             ais_key = ("ais", target.members["ais"])
             xa, pa = states[ais_key]
+            moving = self.config.release_beyond_ais_spread and abs(xa[ekf.U]) > self.config.vessel_speed_mps
             for key in [k for k in target.members.items() if k[0] != "ais"]:
                 xi, pi_ = states[key]
                 d = xi[:2] - xa[:2]
-                moving = self.config.release_beyond_ais_spread and abs(xa[ekf.U]) > self.config.vessel_speed_mps
                 if self._released(d, pi_[:2, :2] + pa[:2, :2], pa[:2, :2] if moving else None):
                     del target.members[key[0]]
             return
         keys = list(target.members.items())
         if self.config.release_least_precise:  # the widest first: of two that disagree, the better one stays
-            keys.sort(key=lambda k: -float(np.trace(states[k][1][:2, :2])))
+            keys.sort(key=lambda k: -_finite_or_inf(float(np.trace(states[k][1][:2, :2]))))
         for key in keys:
             others = [k for k in target.members.items() if k != key]
             if not others:
@@ -551,7 +558,9 @@ class Fuser:
         limit_m = RELEASE_DISTANCES * self.config.max_distance_m
         if spread is not None:
             a, b, c = float(spread[0, 0]), float(spread[1, 0]), float(spread[1, 1])
-            limit_m += FOOTPRINT_SIGMAS * math.sqrt(max(0.5 * (a + c) + math.hypot(0.5 * (a - c), b), 0.0))
+            widening_m = FOOTPRINT_SIGMAS * math.sqrt(max(0.5 * (a + c) + math.hypot(0.5 * (a - c), b), 0.0))
+            if math.isfinite(widening_m):  # a broken covariance does not hold a member for ever
+                limit_m += widening_m
         return mahalanobis2(d, s) > RELEASE_GATES * self._gate or np.hypot(*d) > limit_m
 
     def _classify(self, target: FusedTarget, x: np.ndarray, p: np.ndarray, t_s: float, height_m: float) -> None:

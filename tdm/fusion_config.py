@@ -21,9 +21,9 @@ class FusionConfig:
     # ... and where a still target (iceberg, fixed obstacle) ended less than this ago: it is still there when a
     # weak far echo comes back (busy_open_sea: bergs at 700-1000 m lost by the radar for 60-70 s)
     revive_still_s: float = 300.0
-    # ... also for a target without AIS last reported slower than a still one (half vessel_speed_mps) that ended before
-    # it had settled (settle_s): rough_sea_rain 32's growler, painted by the radar for 7-8 s at a time a minute apart,
-    # took a new id each time
+    # ... also for a target without AIS, not a vessel, last reported slower than a still one (half vessel_speed_mps):
+    # one that ended before it settled (settle_s), whatever its speed's uncertainty. rough_sea_rain 32's growler,
+    # painted by the radar for 7-8 s at a time a minute apart, took a new id each time
     revive_slow_as_still: bool = True
     gate_probability: float = 0.9999
     max_distance_m: float = 60.0

@@ -509,3 +509,15 @@ def test_a_slow_target_that_ended_before_settling_is_looked_for_where_it_was(slo
     moving.step(5.0, {})
     where = make_track(2, "radar", 0.0, 400.0, t=65.0)  # where it was: a moving target is not looked for there
     assert moving.step(65.0, {"radar": [where]})[0].target.target_id != gone.target.target_id
+
+
+def test_a_broken_ais_covariance_does_not_hold_a_far_member_for_ever():
+    """The release test's widening by the AIS coast is left out where that covariance is not finite: a member 500 m
+    off leaves (a NaN limit would keep it for good)."""
+    fuser = Fuser(FusionConfig())
+    far, summed = np.array([500.0, 0.0]), 4.0 * np.eye(2)
+    for broken in (np.full((2, 2), np.nan), np.diag([np.inf, 1.0])):  # the gate test cannot tell either
+        with np.errstate(invalid="ignore"):  # inf x 0 in the gate's algebra
+            assert fuser._released(far, summed + broken, broken)
+    coast = np.diag([1e5, 1.0])  # sd 316 m east: within the gate and within 120 + 3 x 316 m
+    assert not fuser._released(far, summed + coast, coast)
