@@ -56,6 +56,7 @@ from tdm.fusion_config import FusionConfig
 from tdm.fusion_geometry import _EIGEN_TOLERANCE, FOOTPRINT_SIGMAS, MERGE_SIGMAS, MERGE_SPEED_MPS  # noqa: F401
 from tdm.fusion_geometry import clearly_apart as _clearly_apart
 from tdm.fusion_geometry import inside_reference as _inside_reference
+from tdm.fusion_geometry import major_variance as _major_variance
 from tdm.fusion_geometry import moves_apart as _moves_apart
 from tdm.fusion_rules import consider_covariance, fuse
 from tdm.fusion_weights import member_hull_covariance, with_extent, with_fragments, with_hull
@@ -212,20 +213,14 @@ class Fuser:
 
     def _place(self, sensor: str, tr: Track, states: dict, live: dict, t_s: float,
                own_position_m: np.ndarray | None) -> None:
-        """A track that joined no target: absorbed by a target whose footprint (for radar, widened by half the
-        beam's resolution: :meth:`_beyond_size`) holds it; an AIS track instead joins such a target without AIS whose velocity is not known
-        to differ (by the ship's own length when known, or half the radar's resolution at the target's range if
-        larger, as :meth:`_merge_radius` would merge them), as the ship's identity never hides in a target;
-        otherwise a new target, or a recently ended one revived."""
+        """A track that joined no target: absorbed by a target that holds it (:meth:`_holds`); an AIS track instead
+        joins such a target without AIS whose velocity is not known to differ, as the ship's identity never hides in
+        a target; otherwise a new target, or a recently ended one revived."""
         key = (sensor, tr.track_id)
         unresolved_m = self._unresolved_m(sensor, states[key][0], own_position_m)
         ship_m = self._ship_half_length(tr.mmsi) if sensor == "ais" else math.nan
         host = next((t for t in self.targets if (sensor != "ais" or "ais" not in t.members)
-                     and self._inside(self._against(sensor, states[key], est := self._estimate(t, states)),
-                                      centre := est[0],
-                                      max(ship_m, self._unresolved_m("radar" if "radar" in t.members else "", centre,
-                                                                     own_position_m))
-                                      if math.isfinite(ship_m) else self._beyond_size(self._half_length(t, live), unresolved_m))),
+                     and self._holds(t, sensor, states[key], live, states, unresolved_m, ship_m, own_position_m)),
                     None)
         if host is not None and sensor == "ais":
             if _moves_apart(self._estimate(host, states), states[key], older_has_ais=False):
@@ -237,6 +232,22 @@ class Fuser:
         if host is None:
             self.targets.append(self._revive(states[key], t_s) or FusedTarget(next(self._ids), created_s=t_s))
             self.targets[-1].members = {sensor: tr.track_id}
+
+    def _holds(self, target: FusedTarget, sensor: str, state: tuple, live: dict, states: dict, unresolved_m: float,
+               ship_m: float, own_position_m: np.ndarray | None) -> bool:
+        """Whether ``target`` holds a new track of ``sensor`` at ``state`` (:meth:`_place`): within its footprint
+        (for radar, widened by half the beam's resolution at the track's range, ``unresolved_m``:
+        :meth:`_beyond_size`); for an AIS track of a ship of known half length ``ship_m``, within that, or half the
+        radar's resolution at the target's range if larger (as :meth:`_merge_radius` would merge them), with both
+        positions' uncertainty (:meth:`_against`)."""
+        estimate = self._estimate(target, states)
+        centre = estimate[0]
+        if math.isfinite(ship_m):
+            radar = "radar" if "radar" in target.members else ""
+            radius_m = max(ship_m, self._unresolved_m(radar, centre, own_position_m))
+        else:
+            radius_m = self._beyond_size(self._half_length(target, live), unresolved_m)
+        return self._inside(self._against(sensor, state, estimate), centre, radius_m)
 
     def _promote(self, target: FusedTarget, states: dict, live: dict, t_s: float) -> None:
         """An AIS ship's target without a track of a ``join_free_slot`` sensor takes an absorbed track of that sensor
@@ -396,7 +407,7 @@ class Fuser:
         x, p = state
         a, b, d = float(p[0, 0]), float(p[1, 0]), float(p[1, 1])
         distance = math.hypot(float(x[0]) - float(centre[0]), float(x[1]) - float(centre[1]))
-        largest = 0.5 * (a + d) + math.hypot(0.5 * (a - d), b)
+        largest = _major_variance(a, b, d)
         if math.isfinite(largest + distance + half_length_m):
             radius = half_length_m + FOOTPRINT_SIGMAS * math.sqrt(max(largest, 0.0))
             # sqrt moves by at most sqrt of what the eigenvalue moves; both eigenvalues are within a few ulp of |P|
@@ -557,8 +568,8 @@ class Fuser:
         ``spread`` (m^2; the AIS track's own covariance, its coast between reports) along its major axis."""
         limit_m = RELEASE_DISTANCES * self.config.max_distance_m
         if spread is not None:
-            a, b, c = float(spread[0, 0]), float(spread[1, 0]), float(spread[1, 1])
-            widening_m = FOOTPRINT_SIGMAS * math.sqrt(max(0.5 * (a + c) + math.hypot(0.5 * (a - c), b), 0.0))
+            major = _major_variance(float(spread[0, 0]), float(spread[1, 0]), float(spread[1, 1]))
+            widening_m = FOOTPRINT_SIGMAS * math.sqrt(max(major, 0.0))
             if math.isfinite(widening_m):  # a broken covariance does not hold a member for ever
                 limit_m += widening_m
         return mahalanobis2(d, s) > RELEASE_GATES * self._gate or np.hypot(*d) > limit_m

@@ -12,7 +12,8 @@ import numpy as np
 
 from tdm import ekf
 
-__all__ = ["FOOTPRINT_SIGMAS", "MERGE_SIGMAS", "MERGE_SPEED_MPS", "clearly_apart", "inside_reference", "moves_apart"]
+__all__ = ["FOOTPRINT_SIGMAS", "MERGE_SIGMAS", "MERGE_SPEED_MPS", "clearly_apart", "inside_reference", "major_variance",
+           "moves_apart"]
 
 #: A track lies inside a target's footprint within its half length plus this many standard deviations
 #: of the track's position (the radar beam smears a ship's ends by tens of metres at range).
@@ -62,6 +63,12 @@ def moves_apart(older: tuple[np.ndarray, np.ndarray], younger: tuple[np.ndarray,
     index = [ekf.U, ekf.PSI]
     cov = jacobian @ p_other[np.ix_(index, index)] @ jacobian.T + VELOCITY_FLOOR_M2PS2 * np.eye(2)
     return float(beyond @ np.linalg.solve(cov, beyond)) > MERGE_SIGMAS**2
+
+
+def major_variance(a: float, b: float, d: float) -> float:
+    """The larger eigenvalue of the symmetric 2 x 2 ``[[a, b], [b, d]]`` in closed form: the variance along a position
+    covariance's major axis, m^2 (:func:`clearly_apart` does the same on arrays)."""
+    return 0.5 * (a + d) + math.hypot(0.5 * (a - d), b)
 
 
 def inside_reference(state, centre: np.ndarray, half_length_m: float) -> bool:
