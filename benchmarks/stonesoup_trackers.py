@@ -59,7 +59,7 @@ from stonesoup.updater.kalman import ExtendedKalmanUpdater
 from groundfloor.units import KNOT_MPS
 from tdm.detections import AisReport, Detections
 from tdm.pipeline import TdmConfig
-from tdm.tracker import AIS_COG_MIN_SOG_MPS
+from tdm.ais_tracker import AIS_COG_MIN_SOG_MPS
 
 #: Longest time span of one chunk of detections fed to a tracker, per sensor, s: one LiDAR revolution
 #: at 10 Hz; a tenth of a radar revolution at 24 rpm (a target is in one chunk of a sweep); AIS

@@ -41,7 +41,8 @@ from tdm.messages import jsonl_writer, target_records
 from tdm.recording.scenario import MAX_UPDATE_RATE_HZ
 from tdm.run_config import FUSION_RULES, LIDAR_SOURCES, TdmConfig
 from tdm.scans import DetectionStream, start_time_unix_s
-from tdm.tracker import AisTracker, PositionTracker, TrackerConfig
+from tdm.ais_tracker import AisTracker
+from tdm.tracker import PositionTracker, TrackerConfig
 from tdm.workers import BATCH_SCANS, LIDAR_FIELDS, RADAR_FIELDS
 
 __all__ = ["BATCH_SCANS", "DetectionStream", "FUSION_RULES", "LIDAR_FIELDS", "LIDAR_SOURCES", "RADAR_FIELDS",

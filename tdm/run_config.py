@@ -11,7 +11,8 @@ from pathlib import Path
 
 from tdm.fusion import FusionConfig
 from tdm.io import read_scenario
-from tdm.tracker import AisTrackerConfig, TrackerConfig
+from tdm.ais_tracker import AisTrackerConfig
+from tdm.tracker import TrackerConfig
 
 __all__ = ["DEFAULT_UPDATE_RATE_HZ", "FUSION_RULES", "LIDAR_SOURCES", "TdmConfig"]
 
