@@ -123,9 +123,13 @@ class RadarFrontEndConfig:
     land_beam_fraction : float
         With a chart (the recording's land), plots within ``range sin(land_beam_fraction beam_az_deg)``
         of the land are dropped as the land's own echo smeared by the beam (:func:`tdm.land.beam_margin_m`).
-        Default 0.5: half the -3 dB beamwidth either side of a coast face, out to where the one-way pattern is
-        3 dB (two-way 6 dB) under its peak (a radar's azimuth resolution is its beamwidth); 0 turns it off.
-        Not fitted to any scenario: the figure is the beam's.
+        Default 1.0: a whole -3 dB beamwidth off a coast face, where the two-way pattern is 24 dB under its
+        peak: a coast's echo 30-40 dB over the sea still paints there, and an echo nearer is not resolved from
+        the coast's (a radar's azimuth resolution is its beamwidth), as ``land_clear_beam_fraction`` already
+        held for the clutter level. 0.5 (half a beam, two-way 6 dB) until 2026-11-28: the smear's tail, 4-5
+        deg past a quay's edge at 640 m, made plots 37-40 m off the chart's land (half a beam: 29 m) that
+        confirmed as false targets (busy_port seeds 31 and 34, held out; docs/tdm.md). 0 turns it off. Not
+        fitted to any scenario: the figure is the beam's.
     clutter_map_without_land : bool
         With a chart, a plot clear of the land (``land_clear_beam_fraction``) is measured against the
         clutter of its annulus without the blocks on the land (grown by the ``land_beam_fraction``
@@ -186,7 +190,7 @@ class RadarFrontEndConfig:
     bearing_sigma_beam_fraction: float = 0.15
     extent_sigma_fraction: float = 0.25
     core_db: float = 9.0
-    land_beam_fraction: float = 0.5
+    land_beam_fraction: float = 1.0
     clutter_map_without_land: bool = True
     land_clear_beam_fraction: float = 1.0
     sidelobe_margin_db: float | None = 10.0

@@ -17,9 +17,12 @@ beam, and which holds an echo (its maximum at least ``min_seed_db``: the land's 
 shadow), is left out of the annulus of every plot clear of the land. A plot is clear of the land
 when its peak block lies more than a whole beamwidth (``land_clear_beam_fraction``) plus half a block
 from it; a plot nearer keeps the land in its clutter level, since it may be the land's own echo
-smeared beyond half a beam (a strong coast's echo still stands 15-20 dB over the noise a beamwidth
+smeared beyond the dropping margin (a strong coast's echo still stands 15-20 dB over the noise a beamwidth
 off). On busy_port seed 31 without that condition, four more radar-only false targets appeared 20-23 m
-off the quays. A plot whose whole annulus is land is measured against the thermal noise mean
+off the quays, when plots were dropped within half a beam of the land. Since ``land_beam_fraction`` is
+a whole beam too (2026-11-28), a plot whose position lies that near is dropped anyway; the condition
+still decides for a plot whose peak lies nearer the land than its position, and with a smaller
+dropping margin. A plot whose whole annulus is land is measured against the thermal noise mean
 (0 dB). Without land (open sea) nothing changes.
 """
 

@@ -139,6 +139,29 @@ def test_radar_plots_within_half_a_beam_of_a_far_coast_are_dropped_and_near_ones
     assert len(drop_on_land(dets, mask)) == 3  # without the beam: all three are at sea
 
 
+
+def test_the_radar_front_end_drops_plots_within_a_whole_beam_of_a_coast():
+    """The default front end drops a plot 0.75 of a beam off a far coast and keeps one 1.25 beams off.
+
+    A coast 30 dB or more over the sea paints through the two-way beam until its pattern is that far down,
+    24 (theta / theta3)^2 dB: past half a beam (6 dB) out to about a whole one (24 dB). On busy_port seed
+    34 such a smear, a tail of level 1-3 video 4-5 deg past the quay's edge at 640 m, made plots 37-40 m off
+    the chart's land, outside half a beam (29 m), that confirmed as radar-only false targets.
+    """
+    from tdm.frontend.radar_config import RadarFrontEndConfig
+
+    config = RadarFrontEndConfig()
+    frame = EnuFrame(LAT0, LON0)
+    far_coast = [(-300.0, 1000.0), (300.0, 1000.0), (300.0, 1200.0), (-300.0, 1200.0)]
+    mask = LandMask(ChartLand(tuple(_polygons(land_geojson(far_coast, frame))), Path("land.geojson")), frame,
+                    DETECTION_MARGIN_M)
+    beam_m = 1000.0 * np.sin(np.radians(config.beam_az_deg))  # 90.6 m across at 1 km
+    dets = detections_at([(0.0, 1000.0 - 0.75 * beam_m), (0.0, 1000.0 - 1.25 * beam_m)])
+    kept = drop_on_land(dets, mask, config.land_beam_fraction, config.beam_az_deg)
+    assert kept.position_m[:, 1].tolist() == [pytest.approx(1000.0 - 1.25 * beam_m)]
+    assert len(drop_on_land(dets, mask, 0.5, config.beam_az_deg)) == 2  # half a beam keeps the smear's plot
+
+
 def _polygons(collection: dict):
     from shapely.geometry import shape
 
