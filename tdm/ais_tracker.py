@@ -4,7 +4,7 @@ position, course, speed and rate of turn (the thesis's AIS noise model, docs/ref
 from __future__ import annotations
 
 import itertools
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -17,6 +17,11 @@ SECONDS_PER_MINUTE = 60.0
 #: An AIS course over ground is used only above this speed over ground, m/s (0.6 kn: below it the COG
 #: of a drifting ship is noise).
 AIS_COG_MIN_SOG_MPS = 0.3
+#: Navigational statuses of a ship that holds its position (ITU-R M.1371-5, message 1-3).
+AT_ANCHOR, MOORED = 1, 5
+#: Reporting interval of a Class A ship at anchor or moored and not moving faster than 3 kn, s (ITU-R M.1371-5,
+#: Table 1).
+HELD_REPORT_INTERVAL_S = 180.0
 
 
 @dataclass(frozen=True)
@@ -27,6 +32,20 @@ class AisTrackerConfig:
     thesis's ``AIS_*`` parameters): position variance 5 + 0.5 m^2 (white + bias), COG 1 + 0.5
     deg^2, SOG 0.5 + 0.1 kn^2, ROT 2000 + 500 (deg/min)^2. These are what the TDM assumes of any
     transponder; they are not read from the recording.
+
+    Attributes
+    ----------
+    anchored_speed_sigma_mps, moored_speed_sigma_mps : float or None
+        A Class A ship reporting itself at anchor (status 1) or moored (status 5) holds its position: its
+        speed is taken as 0 with this standard deviation, m/s, fused with the reported SOG as a second
+        measurement of the speed, its COG is not used, and till its next report its speed wanders by this
+        much over a reporting interval of such a ship (3 minutes, ITU-R M.1371-5 Table 1), not as one under
+        way does (the process noise's ``speed_m2_per_s3``: 0.5 m/s in 10 s). Such a ship's transponder
+        reads the GNSS's noise as its SOG (the thesis's: 0.77 kn sd); dead-reckoned at a reported 0.6-1.3 kn
+        it drifted 50-120 m between reports (harbour_approach's anchored tanker, busy_port 31's moored
+        coaster). Defaults, not fitted: 0.1 m/s (0.2 kn) at anchor, where a ship swings about its anchor at
+        a few tenths of a knot; 0.01 m/s moored, where it moves by its lines' and fenders' slack, about a
+        metre. None: the status is not used.
     """
 
     position_var_m2: float = 5.5
@@ -34,7 +53,29 @@ class AisTrackerConfig:
     sog_var_kn2: float = 0.6
     rot_var_deg2_per_min2: float = 2500.0
     coast_s: float = 200.0
+    anchored_speed_sigma_mps: float | None = 0.1
+    moored_speed_sigma_mps: float | None = 0.01
+
+    def held_speed_sigma_mps(self, nav_status: int) -> float | None:
+        """The speed's standard deviation of a ship holding its position with this status, m/s; None: not held."""
+        return {AT_ANCHOR: self.anchored_speed_sigma_mps, MOORED: self.moored_speed_sigma_mps}.get(nav_status)
     process: ekf.ProcessNoise = field(default_factory=ekf.ProcessNoise)
+
+
+def _speed_measurement(sog_mps: float, sog_var_mps2: float,
+                       held_sigma_mps: float | None) -> tuple[float, float] | None:
+    """The speed measurement of one report, (m/s, (m/s)^2), or None without any.
+
+    The reported SOG with its variance; for a ship holding its position (``held_sigma_mps`` given), that
+    fused with a speed of 0 +- ``held_sigma_mps``: the product of the two Gaussians, as two measurements of
+    the speed in one update would give.
+    """
+    if held_sigma_mps is None:
+        return (float(sog_mps), sog_var_mps2) if np.isfinite(sog_mps) else None
+    held_var = held_sigma_mps**2
+    if not np.isfinite(sog_mps):
+        return 0.0, held_var
+    return float(sog_mps) * held_var / (held_var + sog_var_mps2), held_var * sog_var_mps2 / (held_var + sog_var_mps2)
 
 
 #: Prior variances of an AIS track's states that its first report does not measure: position
@@ -48,6 +89,14 @@ class AisTracker:
 
     def __init__(self, config: AisTrackerConfig):
         self.config = config
+        #: The motion noise of a ship holding its position, by status: its speed wanders by its speed's standard
+        #: deviation over one reporting interval of a ship at anchor or moored (3 minutes).
+        self._held_process: dict[int, ekf.ProcessNoise] = {}
+        for status in (AT_ANCHOR, MOORED):
+            sigma_mps = config.held_speed_sigma_mps(status)
+            if sigma_mps is not None:
+                self._held_process[status] = replace(config.process,
+                                                     speed_m2_per_s3=sigma_mps**2 / HELD_REPORT_INTERVAL_S)
         self.tracks: dict[int, Track] = {}
         self.static: dict[int, AisStatic] = {}
         self._ids = itertools.count(1)
@@ -57,35 +106,46 @@ class AisTracker:
 
     def process(self, report: AisReport) -> None:
         """Update (or start) the track of the report's MMSI."""
-        cfg = self.config
-        rows, z, var = [ekf.E, ekf.N], [report.position_m[0], report.position_m[1]], [cfg.position_var_m2] * 2
-        angle_rows: tuple[int, ...] = ()
-        moving = np.isfinite(report.sog_mps) and report.sog_mps > AIS_COG_MIN_SOG_MPS
-        if np.isfinite(report.cog_deg) and moving:
-            angle_rows = (len(rows),)
-            rows.append(ekf.PSI)
-            z.append(np.radians(report.cog_deg))
-            var.append(np.radians(1.0) ** 2 * cfg.cog_var_deg2)
-        if np.isfinite(report.sog_mps):
-            rows.append(ekf.U)
-            z.append(report.sog_mps)
-            var.append(cfg.sog_var_kn2 * KNOT_MPS**2)
-        if np.isfinite(report.rot_deg_per_min):
-            rows.append(ekf.R)
-            z.append(np.radians(report.rot_deg_per_min) / SECONDS_PER_MINUTE)
-            var.append(cfg.rot_var_deg2_per_min2 * (np.radians(1.0) / SECONDS_PER_MINUTE) ** 2)
+        rows, z, var, angle_rows = self._measurement(report)
+        process = self._held_process.get(report.nav_status, self.config.process)
         t = float(report.time_s)
         track = self.tracks.get(report.mmsi)
-        if track is None or t - track.updated_s > cfg.coast_s:
-            self.tracks[report.mmsi] = self._start(report, rows, z, var)
+        if track is None or t - track.updated_s > self.config.coast_s:
+            self.tracks[report.mmsi] = self._start(report, rows, z, var, process)
             return
         x, p = track.predicted(t)
         h = ekf.h_rows(*rows)
         track.x, track.p, _ = ekf.update(x, p, np.array(z, dtype=float), h, np.diag(var), angle_rows)
         track.t_s = track.updated_s = t
         track.n_updates += 1
+        track.process = process
 
-    def _start(self, report: AisReport, rows: list[int], z: list[float], var: list[float]) -> Track:
+    def _measurement(self, report: AisReport) -> tuple[list[int], list[float], list[float], tuple[int, ...]]:
+        """The report's measured states: their rows, values and variances, and the angle rows (COG); a ship at
+        anchor or moored holds its position (:meth:`AisTrackerConfig.held_speed_sigma_mps`)."""
+        cfg = self.config
+        rows, z, var = [ekf.E, ekf.N], [report.position_m[0], report.position_m[1]], [cfg.position_var_m2] * 2
+        angle_rows: tuple[int, ...] = ()
+        held_sigma_mps = cfg.held_speed_sigma_mps(report.nav_status)
+        moving = np.isfinite(report.sog_mps) and report.sog_mps > AIS_COG_MIN_SOG_MPS and held_sigma_mps is None
+        if np.isfinite(report.cog_deg) and moving:
+            angle_rows = (len(rows),)
+            rows.append(ekf.PSI)
+            z.append(np.radians(report.cog_deg))
+            var.append(np.radians(1.0) ** 2 * cfg.cog_var_deg2)
+        speed = _speed_measurement(report.sog_mps, cfg.sog_var_kn2 * KNOT_MPS**2, held_sigma_mps)
+        if speed is not None:
+            rows.append(ekf.U)
+            z.append(speed[0])
+            var.append(speed[1])
+        if np.isfinite(report.rot_deg_per_min):
+            rows.append(ekf.R)
+            z.append(np.radians(report.rot_deg_per_min) / SECONDS_PER_MINUTE)
+            var.append(cfg.rot_var_deg2_per_min2 * (np.radians(1.0) / SECONDS_PER_MINUTE) ** 2)
+        return rows, z, var, angle_rows
+
+    def _start(self, report: AisReport, rows: list[int], z: list[float], var: list[float],
+               process: ekf.ProcessNoise) -> Track:
         """A track from its first report: the measured states at their values and variances.
 
         States the report does not carry start at the broad prior :data:`AIS_PRIOR_VAR` (course
@@ -100,7 +160,7 @@ class AisTracker:
             x[ekf.ALPHA] = static.length_m * static.beam_m
         t = float(report.time_s)
         return Track(next(self._ids), "ais", x, p, t, t, t, confirmed=True, n_updates=1, mmsi=report.mmsi,
-                     process=self.config.process)
+                     process=process)
 
     def set_static(self, static: dict[int, AisStatic]) -> None:
         self.static.update(static)

@@ -105,6 +105,9 @@ class AisReport:
     rot_deg_per_min : float
         Rate of turn (NaN when not available).
     msg_type : int
+    nav_status : int
+        Navigational status of a Class A report (ITU-R M.1371-5, message 1-3 bits 38-41: 0 under way using
+        engine, 1 at anchor, 5 moored, ...); 15, "not defined", for Class B reports, which carry none.
     """
 
     time_s: float
@@ -115,6 +118,7 @@ class AisReport:
     heading_deg: float
     rot_deg_per_min: float
     msg_type: int
+    nav_status: int = 15
 
 
 @dataclass

@@ -126,8 +126,10 @@ def _not_available(value, code: float) -> float:
 
 #: Messages whose dimensions and type are read (types 5 and 19 carry them with the name).
 _NAME_AND_SHIP_TYPES = (5, 19)
-#: Types whose ROT indicator is read (Class A position reports).
+#: Types whose ROT indicator and navigational status are read (Class A position reports).
 _CLASS_A_POSITION_TYPES = (1, 2, 3)
+#: Navigational status "not defined" (ITU-R M.1371-5), what a Class B report stands for (it carries none).
+NAV_STATUS_NOT_DEFINED = 15
 #: Payload bits of a type 24 message of an unknown part (the longer, part B).
 _MIN_BITS_24_OTHER = 168
 #: Highest valid true heading, deg (511: not available).
@@ -254,11 +256,12 @@ class _AisDecoder:
         sog = _not_available(msg.speed, SOG_NOT_AVAILABLE_KN) * MPS_PER_KNOT
         cog = _not_available(msg.course, COG_NOT_AVAILABLE_DEG)
         heading = float("nan") if msg.heading is None or msg.heading >= _HEADING_LIMIT_DEG else float(msg.heading)
-        rot = float("nan")
+        rot, status = float("nan"), NAV_STATUS_NOT_DEFINED
         if kind in _CLASS_A_POSITION_TYPES:
             rot = rot_deg_per_min(bit_vector(sentence.payload, sentence.fill_bits).get_num(ROT_BIT, ROT_WIDTH, True))
+            status = int(msg.status)
         self.rows.append((time_unix_s - self.start_time_unix_s, int(msg.mmsi), kind, float(lat), float(lon), cog, sog,
-                          heading, rot))
+                          heading, rot, status))
 
     def reports(self, frame: EnuFrame) -> list[AisReport]:
         """The position reports, sorted by time (stable: file order within a second), in ENU."""
@@ -269,7 +272,7 @@ class _AisDecoder:
         lon = np.array([r[4] for r in rows])
         east, north = frame.to_enu(lat, lon)
         return [AisReport(time_s=r[0], mmsi=r[1], position_m=np.array([e, n]), cog_deg=r[5], sog_mps=r[6],
-                          heading_deg=r[7], rot_deg_per_min=r[8], msg_type=r[2])
+                          heading_deg=r[7], rot_deg_per_min=r[8], msg_type=r[2], nav_status=r[9])
                 for r, e, n in zip(rows, east, north)]
 
 

@@ -6,6 +6,7 @@ import pytest
 from tdm import ekf
 from tdm.ais_tracker import AisTracker, AisTrackerConfig
 from tdm.detections import AisReport
+from tdm.frontend.ais import MPS_PER_KNOT
 
 
 def test_ais_tracks_are_kept_by_mmsi():
@@ -33,3 +34,33 @@ def test_an_ais_track_starts_at_its_first_report(range_m):
     assert np.degrees(track.x[2]) % 360.0 == pytest.approx(120.0)
     assert track.x[3] == pytest.approx(6.0)
     assert track.p[0, 0] == pytest.approx(AisTrackerConfig().position_var_m2)  # the report's own variance
+
+
+def test_a_ship_at_anchor_or_moored_holds_its_position_between_reports():
+    """A Class A ship's transponder reads 1.3 kn along its heading (GNSS noise); held, it reports every 3 minutes.
+
+    Dead-reckoned at 1.3 kn (0.67 m/s) it would be 120 m off 3 minutes on. Held, its speed is the product of
+    N(0.67, 0.40^2) and N(0, sigma^2) m/s: 0.67 sigma^2 / (sigma^2 + 0.158), 0.04 m/s at anchor (sigma 0.1 m/s)
+    and 0.0004 m/s moored (sigma 0.01 m/s).
+    """
+    sog = 1.3 * MPS_PER_KNOT
+    sog_var = AisTrackerConfig().sog_var_kn2 * MPS_PER_KNOT**2
+    free = AisTrackerConfig(anchored_speed_sigma_mps=None, moored_speed_sigma_mps=None)
+    found = {}
+    for name, status, config in (("anchor", 1, AisTrackerConfig()), ("moored", 5, AisTrackerConfig()),
+                                 ("free", 5, free)):
+        tracker = AisTracker(config)
+        tracker.process(AisReport(0.0, 257000700, np.array([200.0, 300.0]), 64.0, sog, 64.0, 0.0, 1, nav_status=status))
+        track = tracker.tracks[257000700]
+        x, p = track.predicted(179.0)
+        found[name] = (track.x[ekf.U], np.hypot(*(x[:2] - [200.0, 300.0])), np.sqrt(np.trace(p[:2, :2])))
+    assert found["anchor"][0] == pytest.approx(sog * 0.01 / (0.01 + sog_var))
+    assert found["moored"][0] == pytest.approx(sog * 1e-4 / (1e-4 + sog_var))
+    assert found["anchor"][1] < 10.0 and found["moored"][1] < 0.5 and found["free"][1] > 100.0  # drift, m
+    # the uncertainty 3 minutes on: a ship swinging at anchor, one made fast, one under way
+    assert found["moored"][2] < 6.0 < found["anchor"][2] < 60.0 < 600.0 < found["free"][2]
+    # under way (status 0), or a Class B report (no status: 15), the reported speed is the speed
+    for status in (0, 15):
+        tracker = AisTracker(AisTrackerConfig())
+        tracker.process(AisReport(0.0, 257000701, np.zeros(2), 64.0, sog, 64.0, 0.0, 1, nav_status=status))
+        assert tracker.tracks[257000701].x[ekf.U] == pytest.approx(sog)

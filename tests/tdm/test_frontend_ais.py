@@ -206,3 +206,14 @@ def test_fields_of_hand_made_messages(tmp_path):
     assert (static[257000300].length_m, static[257000300].beam_m) == (9.0, 3.0)
     first = static[257000100]
     assert first.name == "FIRST ONE" and first.ship_type == 52 and math.isnan(first.length_m) and first.beam_m == 6.0
+
+
+def test_the_navigational_status_of_class_a_reports_is_read_and_class_b_has_none(tmp_path):
+    frame = EnuFrame(59.44, 10.47)
+    lines = [tagged(int(START) + 10 + i, vdm({**type1(mmsi=257000500 + i), "status": status})[0])
+             for i, status in enumerate([0, 1, 5])]
+    lines.append(tagged(int(START) + 20, vdm({"msg_type": 18, "mmsi": 257000600, "speed": 1.3, "accuracy": 1,
+                                               "lon": 10.47, "lat": 59.45, "course": 64.0, "heading": 64,
+                                               "second": 0, "cs": 1, "band": 1, "radio": 0})[0]))
+    reports, _ = read_ais(write_lines(tmp_path / "ais.nmea", lines), frame, START, ReadStats())
+    assert {r.mmsi: r.nav_status for r in reports} == {257000500: 0, 257000501: 1, 257000502: 5, 257000600: 15}
