@@ -22,6 +22,8 @@ AT_ANCHOR, MOORED = 1, 5
 #: Reporting interval of a Class A ship at anchor or moored and not moving faster than 3 kn, s (ITU-R M.1371-5,
 #: Table 1).
 HELD_REPORT_INTERVAL_S = 180.0
+#: Fastest SOG of a ship at anchor or moored that reports at that interval, m/s (3 kn, ITU-R M.1371-5 Table 1).
+HELD_MAX_SOG_MPS = 3.0 * KNOT_MPS
 
 
 @dataclass(frozen=True)
@@ -45,7 +47,8 @@ class AisTrackerConfig:
         it drifted 50-120 m between reports (harbour_approach's anchored tanker, busy_port 31's moored
         coaster). Defaults, not fitted: 0.1 m/s (0.2 kn) at anchor, where a ship swings about its anchor at
         a few tenths of a knot; 0.01 m/s moored, where it moves by its lines' and fenders' slack, about a
-        metre. None: the status is not used.
+        metre. A report of more than 3 kn is of a ship under way, whatever its status (the fastest a ship at
+        anchor or moored reporting every 3 minutes goes, ITU-R M.1371-5). None: the status is not used.
     """
 
     position_var_m2: float = 5.5
@@ -56,8 +59,12 @@ class AisTrackerConfig:
     anchored_speed_sigma_mps: float | None = 0.1
     moored_speed_sigma_mps: float | None = 0.01
 
-    def held_speed_sigma_mps(self, nav_status: int) -> float | None:
-        """The speed's standard deviation of a ship holding its position with this status, m/s; None: not held."""
+    def held_speed_sigma_mps(self, nav_status: int, sog_mps: float = float("nan")) -> float | None:
+        """The speed's standard deviation of a ship holding its position with this status and SOG, m/s; None: not
+        held. A ship reporting more than :data:`HELD_MAX_SOG_MPS` is under way whatever its status says (statuses
+        are set by hand and left behind)."""
+        if sog_mps > HELD_MAX_SOG_MPS:
+            return None
         return {AT_ANCHOR: self.anchored_speed_sigma_mps, MOORED: self.moored_speed_sigma_mps}.get(nav_status)
     process: ekf.ProcessNoise = field(default_factory=ekf.ProcessNoise)
 
@@ -106,8 +113,9 @@ class AisTracker:
 
     def process(self, report: AisReport) -> None:
         """Update (or start) the track of the report's MMSI."""
-        rows, z, var, angle_rows = self._measurement(report)
-        process = self._held_process.get(report.nav_status, self.config.process)
+        held_sigma_mps = self.config.held_speed_sigma_mps(report.nav_status, report.sog_mps)
+        rows, z, var, angle_rows = self._measurement(report, held_sigma_mps)
+        process = self.config.process if held_sigma_mps is None else self._held_process[report.nav_status]
         t = float(report.time_s)
         track = self.tracks.get(report.mmsi)
         if track is None or t - track.updated_s > self.config.coast_s:
@@ -120,13 +128,13 @@ class AisTracker:
         track.n_updates += 1
         track.process = process
 
-    def _measurement(self, report: AisReport) -> tuple[list[int], list[float], list[float], tuple[int, ...]]:
-        """The report's measured states: their rows, values and variances, and the angle rows (COG); a ship at
-        anchor or moored holds its position (:meth:`AisTrackerConfig.held_speed_sigma_mps`)."""
+    def _measurement(self, report: AisReport,
+                     held_sigma_mps: float | None) -> tuple[list[int], list[float], list[float], tuple[int, ...]]:
+        """The report's measured states: their rows, values and variances, and the angle rows (COG); with
+        ``held_sigma_mps``, the ship holds its position (:meth:`AisTrackerConfig.held_speed_sigma_mps`)."""
         cfg = self.config
         rows, z, var = [ekf.E, ekf.N], [report.position_m[0], report.position_m[1]], [cfg.position_var_m2] * 2
         angle_rows: tuple[int, ...] = ()
-        held_sigma_mps = cfg.held_speed_sigma_mps(report.nav_status)
         moving = np.isfinite(report.sog_mps) and report.sog_mps > AIS_COG_MIN_SOG_MPS and held_sigma_mps is None
         if np.isfinite(report.cog_deg) and moving:
             angle_rows = (len(rows),)

@@ -59,8 +59,10 @@ def test_a_ship_at_anchor_or_moored_holds_its_position_between_reports():
     assert found["anchor"][1] < 10.0 and found["moored"][1] < 0.5 and found["free"][1] > 100.0  # drift, m
     # the uncertainty 3 minutes on: a ship swinging at anchor, one made fast, one under way
     assert found["moored"][2] < 6.0 < found["anchor"][2] < 60.0 < 600.0 < found["free"][2]
-    # under way (status 0), or a Class B report (no status: 15), the reported speed is the speed
-    for status in (0, 15):
+    # under way (status 0), a Class B report (no status: 15), or over 3 kn whatever the status says (a status
+    # left at anchor by a ship under way), the reported speed is the speed
+    for status, sog_mps in ((0, sog), (15, sog), (1, 4.0 * MPS_PER_KNOT), (5, 4.0 * MPS_PER_KNOT)):
         tracker = AisTracker(AisTrackerConfig())
-        tracker.process(AisReport(0.0, 257000701, np.zeros(2), 64.0, sog, 64.0, 0.0, 1, nav_status=status))
-        assert tracker.tracks[257000701].x[ekf.U] == pytest.approx(sog)
+        tracker.process(AisReport(0.0, 257000701, np.zeros(2), 64.0, sog_mps, 64.0, 0.0, 1, nav_status=status))
+        assert tracker.tracks[257000701].x[ekf.U] == pytest.approx(sog_mps)
+        assert tracker.tracks[257000701].process.speed_m2_per_s3 == AisTrackerConfig().process.speed_m2_per_s3
