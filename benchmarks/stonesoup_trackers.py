@@ -6,13 +6,16 @@ What Stone Soup is given (the information our trackers use):
   state ``[east, v_east, north, v_north]`` whose covariance is the detection's own
   ``position_cov_m2`` (no floor added: our floors are our own tuning).
 - **AIS kinematics**: a report with a speed over ground above our AIS tracker's
-  :data:`tdm.tracker.AIS_COG_MIN_SOG_MPS` and a course over ground is a 4-D measurement of the
+  :data:`tdm.ais_tracker.AIS_COG_MIN_SOG_MPS` and a course over ground is a 4-D measurement of the
   whole state (``LinearGaussian`` on dims 0-3): position with our AIS tracker's
   ``position_var_m2`` per axis, velocity ``SOG (sin COG, cos COG)`` with the covariance of our
   ``sog_var_kn2`` and ``cog_var_deg2`` carried through that map (first order,
   :func:`ais_velocity_cov`). Slower reports, or reports without COG, are positions only (our AIS
   tracker then uses no COG either, but still the SOG: a little information Stone Soup does not
-  get). All variances are read from :class:`tdm.pipeline.TdmConfig`.
+  get). All variances are read from :class:`tdm.pipeline.TdmConfig`. Our AIS tracker also holds a Class
+  A ship that reports itself at anchor or moored at speed 0 (:mod:`tdm.ais_tracker`); Stone Soup is not given
+  the status, but none of the comparison's scenarios (busy_open_sea, crossing_silent_ship, rough_sea_rain) has
+  such a ship, so neither tracker uses it there.
 - **Plot strengths**: chosen as *seeding*: a radar plot may start a (holding) track only when its
   ``strength_db`` is at least ``min_strength_db`` and its ``beam_fill`` at least our radar
   tracker's ``min_beam_fill`` (:class:`StrengthGatedInitiator`), while every plot may update

@@ -37,18 +37,33 @@ class AisTrackerConfig:
 
     Attributes
     ----------
+    position_var_m2 : float
+        Variance of a reported position per axis, m^2.
+    cog_var_deg2 : float
+        Variance of a reported COG, deg^2 (used above :data:`AIS_COG_MIN_SOG_MPS`).
+    sog_var_kn2 : float
+        Variance of a reported SOG, kn^2.
+    rot_var_deg2_per_min2 : float
+        Variance of a reported rate of turn, (deg/min)^2.
+    coast_s : float
+        A track whose last report is older than this is dropped, s (and a report after it starts a new one).
     anchored_speed_sigma_mps, moored_speed_sigma_mps : float or None
-        A Class A ship reporting itself at anchor (status 1) or moored (status 5) holds its position: its
-        speed is taken as 0 with this standard deviation, m/s, fused with the reported SOG as a second
-        measurement of the speed, its COG is not used, and till its next report its speed wanders by this
-        much over a reporting interval of such a ship (3 minutes, ITU-R M.1371-5 Table 1), not as one under
-        way does (the process noise's ``speed_m2_per_s3``: 0.5 m/s in 10 s). Such a ship's transponder
-        reads the GNSS's noise as its SOG (the thesis's: 0.77 kn sd); dead-reckoned at a reported 0.6-1.3 kn
-        it drifted 50-120 m between reports (harbour_approach's anchored tanker, busy_port 31's moored
-        coaster). Defaults, not fitted: 0.1 m/s (0.2 kn) at anchor, where a ship swings about its anchor at
-        a few tenths of a knot; 0.01 m/s moored, where it moves by its lines' and fenders' slack, about a
-        metre. A report of more than 3 kn is of a ship under way, whatever its status (the fastest a ship at
-        anchor or moored reporting every 3 minutes goes, ITU-R M.1371-5). None: the status is not used.
+        A Class A ship reporting itself at anchor (status 1) or moored (status 5), at 3 kn or less, holds its
+        position: its speed is taken as 0 with this standard deviation, m/s (> 0), fused with the reported SOG
+        as a second measurement of the speed (without a SOG, 0 with this deviation), its COG is not used, and
+        till its next report its speed wanders by this much over a reporting interval of such a ship (3
+        minutes, ITU-R M.1371-5 Table 1), not as one under way does (the process noise's ``speed_m2_per_s3``:
+        0.5 m/s in 10 s). Such a ship's transponder reads the GNSS's noise as its SOG (the thesis's: 0.77 kn
+        sd); dead-reckoned at a reported 0.6-1.3 kn it drifted 50-120 m between reports (harbour_approach's
+        anchored tanker, busy_port 31's moored coaster: held-out runs, docs/tdm.md "Tracking"). 0.1 m/s (0.2
+        kn) at anchor, where a ship swings about its anchor at a few tenths of a knot; 0.01 m/s moored, where
+        it moves by its lines' and fenders' slack, about a metre. Fitted to no scenario, but the moored figure
+        and the held motion noise were chosen after a held-out run showed the first form's NEES (docs/tdm.md).
+        A report of more than 3 kn is of a ship under way, whatever its status (the fastest a ship at anchor
+        or moored reporting every 3 minutes goes, ITU-R M.1371-5). The first report under way of a held ship
+        starts its track's state again from that report alone (its id kept). None: the status is not used.
+    process : ekf.ProcessNoise
+        Motion noise of a ship under way.
     """
 
     position_var_m2: float = 5.5
@@ -58,24 +73,55 @@ class AisTrackerConfig:
     coast_s: float = 200.0
     anchored_speed_sigma_mps: float | None = 0.1
     moored_speed_sigma_mps: float | None = 0.01
+    process: ekf.ProcessNoise = field(default_factory=ekf.ProcessNoise)
+
+    def __post_init__(self):
+        for name in ("anchored_speed_sigma_mps", "moored_speed_sigma_mps"):
+            sigma_mps = getattr(self, name)
+            if sigma_mps is not None and not sigma_mps > 0.0:
+                raise ValueError(f"{name} must be > 0 m/s or None, not {sigma_mps!r}")
 
     def held_speed_sigma_mps(self, nav_status: int, sog_mps: float = float("nan")) -> float | None:
-        """The speed's standard deviation of a ship holding its position with this status and SOG, m/s; None: not
-        held. A ship reporting more than :data:`HELD_MAX_SOG_MPS` is under way whatever its status says (statuses
-        are set by hand and left behind)."""
+        """The speed's standard deviation of a ship that holds its position.
+
+        Parameters
+        ----------
+        nav_status : int
+            The report's navigational status (ITU-R M.1371-5; 15: not defined).
+        sog_mps : float
+            The report's SOG, m/s (NaN: not available).
+
+        Returns
+        -------
+        float or None
+            m/s; None when the ship is not held: its status is neither at anchor nor moored, that status's figure
+            is None, or it reports more than :data:`HELD_MAX_SOG_MPS` (under way whatever its status says:
+            statuses are set by hand and left behind).
+        """
         if sog_mps > HELD_MAX_SOG_MPS:
             return None
         return {AT_ANCHOR: self.anchored_speed_sigma_mps, MOORED: self.moored_speed_sigma_mps}.get(nav_status)
-    process: ekf.ProcessNoise = field(default_factory=ekf.ProcessNoise)
 
 
 def _speed_measurement(sog_mps: float, sog_var_mps2: float,
                        held_sigma_mps: float | None) -> tuple[float, float] | None:
-    """The speed measurement of one report, (m/s, (m/s)^2), or None without any.
+    """The speed measurement of one report.
 
-    The reported SOG with its variance; for a ship holding its position (``held_sigma_mps`` given), that
-    fused with a speed of 0 +- ``held_sigma_mps``: the product of the two Gaussians, as two measurements of
-    the speed in one update would give.
+    Parameters
+    ----------
+    sog_mps : float
+        The reported SOG, m/s (NaN: not available).
+    sog_var_mps2 : float
+        Its variance, (m/s)^2.
+    held_sigma_mps : float or None
+        For a ship holding its position, the standard deviation of its speed about 0, m/s; None otherwise.
+
+    Returns
+    -------
+    tuple of float or None
+        (speed m/s, variance (m/s)^2): the SOG; for a held ship, the SOG fused with a speed of 0 +- ``held_sigma_mps``
+        (the product of the two Gaussians, as two measurements of the speed in one update would give), or 0 +-
+        ``held_sigma_mps`` without a SOG. None: no speed measured.
     """
     if held_sigma_mps is None:
         return (float(sog_mps), sog_var_mps2) if np.isfinite(sog_mps) else None
@@ -109,24 +155,33 @@ class AisTracker:
         self._ids = itertools.count(1)
 
     def confirmed_tracks(self) -> list[Track]:
+        """Every live AIS track (an AIS track is confirmed by its first report)."""
         return list(self.tracks.values())
 
     def process(self, report: AisReport) -> None:
         """Update (or start) the track of the report's MMSI."""
         held_sigma_mps = self.config.held_speed_sigma_mps(report.nav_status, report.sog_mps)
         rows, z, var, angle_rows = self._measurement(report, held_sigma_mps)
-        process = self.config.process if held_sigma_mps is None else self._held_process[report.nav_status]
+        noise = self.config.process if held_sigma_mps is None else self._held_process[report.nav_status]
         t = float(report.time_s)
         track = self.tracks.get(report.mmsi)
         if track is None or t - track.updated_s > self.config.coast_s:
-            self.tracks[report.mmsi] = self._start(report, rows, z, var, process)
+            self.tracks[report.mmsi] = self._start(report, rows, z, var, noise)
+            return
+        if held_sigma_mps is None and track.process is not noise:
+            # a held ship got under way at some time since its last report: its state starts again from this
+            # report, as a new track's would (its id kept); nothing of its held speed carries over
+            track.x, track.p = self._first_state(report, rows, z, var)
+            track.t_s = track.updated_s = t
+            track.n_updates += 1
+            track.process = noise
             return
         x, p = track.predicted(t)
         h = ekf.h_rows(*rows)
         track.x, track.p, _ = ekf.update(x, p, np.array(z, dtype=float), h, np.diag(var), angle_rows)
         track.t_s = track.updated_s = t
         track.n_updates += 1
-        track.process = process
+        track.process = noise
 
     def _measurement(self, report: AisReport,
                      held_sigma_mps: float | None) -> tuple[list[int], list[float], list[float], tuple[int, ...]]:
@@ -153,12 +208,21 @@ class AisTracker:
         return rows, z, var, angle_rows
 
     def _start(self, report: AisReport, rows: list[int], z: list[float], var: list[float],
-               process: ekf.ProcessNoise) -> Track:
+               noise: ekf.ProcessNoise) -> Track:
         """A track from its first report: the measured states at their values and variances.
 
         States the report does not carry start at the broad prior :data:`AIS_PRIOR_VAR` (course
         unknown, speed and turn rate about 0, cross-section from the static data when known).
         """
+        x, p = self._first_state(report, rows, z, var)
+        t = float(report.time_s)
+        return Track(next(self._ids), "ais", x, p, t, t, t, confirmed=True, n_updates=1, mmsi=report.mmsi,
+                     process=noise)
+
+    def _first_state(self, report: AisReport, rows: list[int], z: list[float],
+                     var: list[float]) -> tuple[np.ndarray, np.ndarray]:
+        """State (6,) and covariance (6, 6) from one report alone: the measured states at their values and
+        variances, the others at :data:`AIS_PRIOR_VAR` (cross-section from the static data when known)."""
         x = np.zeros(ekf.N_STATES)
         p = np.diag(AIS_PRIOR_VAR)
         x[rows] = z
@@ -166,11 +230,10 @@ class AisTracker:
         static = self.static.get(report.mmsi)
         if static is not None and np.isfinite(static.length_m * static.beam_m):
             x[ekf.ALPHA] = static.length_m * static.beam_m
-        t = float(report.time_s)
-        return Track(next(self._ids), "ais", x, p, t, t, t, confirmed=True, n_updates=1, mmsi=report.mmsi,
-                     process=process)
+        return x, p
 
     def set_static(self, static: dict[int, AisStatic]) -> None:
+        """Add static data (name, type, dimensions) by MMSI; later entries replace earlier ones."""
         self.static.update(static)
 
     def expire(self, t_s: float) -> None:

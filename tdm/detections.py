@@ -87,6 +87,10 @@ class Detections:
                    np.zeros(0, dtype=np.int64), z)
 
 
+#: Navigational status "not defined" (ITU-R M.1371-5), what a Class B report stands for (it carries none).
+NAV_STATUS_NOT_DEFINED = 15
+
+
 @dataclass
 class AisReport:
     """One decoded AIS position report in ENU.
@@ -107,7 +111,8 @@ class AisReport:
     msg_type : int
     nav_status : int
         Navigational status of a Class A report (ITU-R M.1371-5, message 1-3 bits 38-41: 0 under way using
-        engine, 1 at anchor, 5 moored, ...); 15, "not defined", for Class B reports, which carry none.
+        engine, 1 at anchor, 5 moored, ...); :data:`NAV_STATUS_NOT_DEFINED` (15) for Class B reports, which carry
+        none.
     """
 
     time_s: float
@@ -118,7 +123,7 @@ class AisReport:
     heading_deg: float
     rot_deg_per_min: float
     msg_type: int
-    nav_status: int = 15
+    nav_status: int = NAV_STATUS_NOT_DEFINED
 
 
 @dataclass

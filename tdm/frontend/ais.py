@@ -45,7 +45,7 @@ from pyais.exceptions import AISBaseException, UnknownMessageException
 from pyais.messages import NMEASentenceFactory
 
 from groundfloor.units import MPS_PER_KNOT  # docs/reference.md section 1
-from tdm.detections import AisReport, AisStatic, ReadStats
+from tdm.detections import NAV_STATUS_NOT_DEFINED, AisReport, AisStatic, ReadStats
 from tdm.frames import EnuFrame
 
 __all__ = ["read_ais", "rot_deg_per_min", "MPS_PER_KNOT"]
@@ -128,8 +128,6 @@ def _not_available(value, code: float) -> float:
 _NAME_AND_SHIP_TYPES = (5, 19)
 #: Types whose ROT indicator and navigational status are read (Class A position reports).
 _CLASS_A_POSITION_TYPES = (1, 2, 3)
-#: Navigational status "not defined" (ITU-R M.1371-5), what a Class B report stands for (it carries none).
-NAV_STATUS_NOT_DEFINED = 15
 #: Payload bits of a type 24 message of an unknown part (the longer, part B).
 _MIN_BITS_24_OTHER = 168
 #: Highest valid true heading, deg (511: not available).

@@ -15,6 +15,7 @@ from tdm.cli import main as tdm_main
 from tdm.detections import Detections
 from tdm.evaluate import evaluate
 from tdm.frames import EnuFrame
+from tdm.frontend.radar_config import RadarFrontEndConfig
 from tdm.land import DETECTION_MARGIN_M, LandMask, beam_margin_m, drop_on_land, on_chart_land
 from tdm.recording.land import ChartLand, read_land
 
@@ -139,17 +140,15 @@ def test_radar_plots_within_half_a_beam_of_a_far_coast_are_dropped_and_near_ones
     assert len(drop_on_land(dets, mask)) == 3  # without the beam: all three are at sea
 
 
-
-def test_the_radar_front_end_drops_plots_within_a_whole_beam_of_a_coast():
-    """The default front end drops a plot 0.75 of a beam off a far coast and keeps one 1.25 beams off.
+def test_the_default_radar_land_margin_drops_plots_within_a_whole_beam_of_a_coast():
+    """With the front end's default margin (as the workers apply it, tdm/workers.py), a plot 0.75 of a beam off a
+    far coast is dropped and one 1.25 beams off kept.
 
     A coast 30 dB or more over the sea paints through the two-way beam until its pattern is that far down,
     24 (theta / theta3)^2 dB: past half a beam (6 dB) out to about a whole one (24 dB). On busy_port seed
     34 such a smear, a tail of level 1-3 video 4-5 deg past the quay's edge at 640 m, made plots 37-40 m off
     the chart's land, outside half a beam (29 m), that confirmed as radar-only false targets.
     """
-    from tdm.frontend.radar_config import RadarFrontEndConfig
-
     config = RadarFrontEndConfig()
     frame = EnuFrame(LAT0, LON0)
     far_coast = [(-300.0, 1000.0), (300.0, 1000.0), (300.0, 1200.0), (-300.0, 1200.0)]
