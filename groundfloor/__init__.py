@@ -6,6 +6,7 @@ whatever both must agree on lives here, once (docs/architecture.md "Floors"):
 - :mod:`groundfloor.frames`: local ENU metres about an origin, body-to-world rotations, marine
   angles, sensor mounts;
 - :mod:`groundfloor.units`: the knot and the nautical mile;
+- :mod:`groundfloor.ais`: AIS navigational statuses and the reporting interval of a ship at anchor or moored;
 - :mod:`groundfloor.hdl32e`: the Velodyne HDL-32E's facts (lasers, firing schedule, packet layout,
   the decoders' azimuths);
 - :mod:`groundfloor.staging`: output directories that appear whole or not at all, write faults,

@@ -14,10 +14,11 @@ from __future__ import annotations
 
 import math
 
+from groundfloor.ais import NAV_STATUS
+
 __all__ = ["NAV_STATUS", "UNIT_MODEL_CODE", "VENDOR_ID", "position_report", "class_b_report", "rot_code",
            "static_report", "static_report_b", "unit_serial", "ais_text"]
 
-NAV_STATUS = {"under_way": 0, "at_anchor": 1, "moored": 5}
 #: Message 24 part B's 42-bit vendor ID (ITU-R M.1371-5, message 24 and Annex 7): the manufacturer's
 #: ID, 3 six-bit characters (18 bits; "RAYSIM" would be cut to "RAY"), then the unit model code
 #: (4 bits, 0..15) and the unit serial number (20 bits, 0..1048575).

@@ -8,6 +8,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from groundfloor.ais import HELD_MAX_SOG_KN, HELD_REPORT_INTERVAL_S, NAV_STATUS_AT_ANCHOR, NAV_STATUS_MOORED
 from groundfloor.units import KNOT_MPS
 from tdm import ekf
 from tdm.detections import AisReport, AisStatic
@@ -17,13 +18,8 @@ SECONDS_PER_MINUTE = 60.0
 #: An AIS course over ground is used only above this speed over ground, m/s (0.6 kn: below it the COG
 #: of a drifting ship is noise).
 AIS_COG_MIN_SOG_MPS = 0.3
-#: Navigational statuses of a ship that holds its position (ITU-R M.1371-5, message 1-3).
-AT_ANCHOR, MOORED = 1, 5
-#: Reporting interval of a Class A ship at anchor or moored and not moving faster than 3 kn, s (ITU-R M.1371-5,
-#: Table 1).
-HELD_REPORT_INTERVAL_S = 180.0
-#: Fastest SOG of a ship at anchor or moored that reports at that interval, m/s (3 kn, ITU-R M.1371-5 Table 1).
-HELD_MAX_SOG_MPS = 3.0 * KNOT_MPS
+#: Fastest SOG of a ship at anchor or moored that reports every 3 minutes, m/s (3 kn, ITU-R M.1371-5 Table 1).
+HELD_MAX_SOG_MPS = HELD_MAX_SOG_KN * KNOT_MPS
 
 
 @dataclass(frozen=True)
@@ -100,7 +96,8 @@ class AisTrackerConfig:
         """
         if sog_mps > HELD_MAX_SOG_MPS:
             return None
-        return {AT_ANCHOR: self.anchored_speed_sigma_mps, MOORED: self.moored_speed_sigma_mps}.get(nav_status)
+        return {NAV_STATUS_AT_ANCHOR: self.anchored_speed_sigma_mps,
+                NAV_STATUS_MOORED: self.moored_speed_sigma_mps}.get(nav_status)
 
 
 def _speed_measurement(sog_mps: float, sog_var_mps2: float,
@@ -145,7 +142,7 @@ class AisTracker:
         #: The motion noise of a ship holding its position, by status: its speed wanders by its speed's standard
         #: deviation over one reporting interval of a ship at anchor or moored (3 minutes).
         self._held_process: dict[int, ekf.ProcessNoise] = {}
-        for status in (AT_ANCHOR, MOORED):
+        for status in (NAV_STATUS_AT_ANCHOR, NAV_STATUS_MOORED):
             sigma_mps = config.held_speed_sigma_mps(status)
             if sigma_mps is not None:
                 self._held_process[status] = replace(config.process,
@@ -172,13 +169,10 @@ class AisTracker:
             # a held ship got under way at some time since its last report: its state starts again from this
             # report, as a new track's would (its id kept); nothing of its held speed carries over
             track.x, track.p = self._first_state(report, rows, z, var)
-            track.t_s = track.updated_s = t
-            track.n_updates += 1
-            track.process = noise
-            return
-        x, p = track.predicted(t)
-        h = ekf.h_rows(*rows)
-        track.x, track.p, _ = ekf.update(x, p, np.array(z, dtype=float), h, np.diag(var), angle_rows)
+        else:
+            x, p = track.predicted(t)
+            h = ekf.h_rows(*rows)
+            track.x, track.p, _ = ekf.update(x, p, np.array(z, dtype=float), h, np.diag(var), angle_rows)
         track.t_s = track.updated_s = t
         track.n_updates += 1
         track.process = noise

@@ -11,6 +11,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from groundfloor.ais import NAV_STATUS_NOT_DEFINED
+
 
 @dataclass
 class Detections:
@@ -87,10 +89,6 @@ class Detections:
                    np.zeros(0, dtype=np.int64), z)
 
 
-#: Navigational status "not defined" (ITU-R M.1371-5), what a Class B report stands for (it carries none).
-NAV_STATUS_NOT_DEFINED = 15
-
-
 @dataclass
 class AisReport:
     """One decoded AIS position report in ENU.
@@ -111,7 +109,7 @@ class AisReport:
     msg_type : int
     nav_status : int
         Navigational status of a Class A report (ITU-R M.1371-5, message 1-3 bits 38-41: 0 under way using
-        engine, 1 at anchor, 5 moored, ...); :data:`NAV_STATUS_NOT_DEFINED` (15) for Class B reports, which carry
+        engine, 1 at anchor, 5 moored, ...); :data:`groundfloor.ais.NAV_STATUS_NOT_DEFINED` (15) for Class B reports, which carry
         none.
     """
 

@@ -19,6 +19,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from groundfloor.ais import HELD_MAX_SOG_KN, HELD_REPORT_INTERVAL_S
+
 __all__ = ["SLOT_S", "class_a_interval_s", "class_b_interval_s", "due_times", "TURNING_DEG_PER_MIN"]
 
 SLOT_S = 60.0 / 2250.0  # one TDMA slot (2250 per minute per channel)
@@ -46,7 +48,7 @@ def class_a_interval_s(sog_kn: np.ndarray, turning: np.ndarray, anchored: np.nda
     turning = np.asarray(turning, dtype=bool)
     interval = np.where(sog > 23.0, 2.0,
                         np.where(sog > 14.0, np.where(turning, 2.0, 6.0), np.where(turning, 10.0 / 3.0, 10.0)))
-    return np.where(np.asarray(anchored, dtype=bool) & (sog < 3.0), 180.0, interval)
+    return np.where(np.asarray(anchored, dtype=bool) & (sog < HELD_MAX_SOG_KN), HELD_REPORT_INTERVAL_S, interval)
 
 
 def class_b_interval_s(sog_kn: np.ndarray) -> np.ndarray:

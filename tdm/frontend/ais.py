@@ -44,8 +44,9 @@ from pyais import NMEAMessage, bit_vector
 from pyais.exceptions import AISBaseException, UnknownMessageException
 from pyais.messages import NMEASentenceFactory
 
+from groundfloor.ais import NAV_STATUS_NOT_DEFINED
 from groundfloor.units import MPS_PER_KNOT  # docs/reference.md section 1
-from tdm.detections import NAV_STATUS_NOT_DEFINED, AisReport, AisStatic, ReadStats
+from tdm.detections import AisReport, AisStatic, ReadStats
 from tdm.frames import EnuFrame
 
 __all__ = ["read_ais", "rot_deg_per_min", "MPS_PER_KNOT"]
