@@ -44,6 +44,10 @@ cells), so that their per-cell arrays stay in cache; every step reads only the c
    when it lies on a spoke between two detections and every cell from one to the other has a
    level >= ``fill_level``.
 
+3b. Optional (``clutter_map_detection``, off by default; :mod:`tdm.frontend.radar_extended`): every cell whose
+   beam-integrated power reaches its block's clutter-map seed threshold (step 5) is a detection too, so the
+   interior of an echo that masked itself joins its edges.
+
 4. Plots (:func:`label_plots`, :mod:`tdm.frontend.radar_plots`): connected components of the detections, 8-connected and circular in azimuth (the last
    spoke touches the first), the same partition ``scipy.ndimage.label`` gives once the components
    that touch across the seam are merged (tested); worked out on runs along range and
@@ -91,6 +95,7 @@ from tdm.frontend.radar_cfar import (VIDEO_LEVELS, _cfar_cells, _first_valid_sam
 from tdm.frontend.radar_clutter import (LandBlocks, _group_sums, _margin_over_clutter_db, _windows, beam_integrated_power,
                                        clutter_map, integration_group)
 from tdm.frontend.radar_config import RadarFrontEndConfig, ca_alpha, mount_from_scenario, os_alpha
+from tdm.frontend.radar_extended import clutter_map_cells
 from tdm.frontend.radar_land import land_blocks
 from tdm.frontend.radar_plots import _runs, fill_gaps, label_plots
 from tdm.land import LandMask
@@ -248,6 +253,8 @@ def _kept_plots(echo: np.ndarray, range_m: np.ndarray, config: RadarFrontEndConf
     """
     n_spokes, n_samples = echo.shape
     flat, integrated, g = _plot_cells(echo, range_m, config)
+    if config.clutter_map_detection:
+        flat = np.union1d(flat, clutter_map_cells(echo, range_m, integrated, g, config))
     if flat.size == 0:
         return None
     runs = _label_runs(flat, n_spokes, n_samples)
