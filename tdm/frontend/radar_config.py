@@ -54,10 +54,9 @@ class RadarFrontEndConfig:
     clutter_map_detection : bool
         Also detect every cell whose beam-integrated power reaches its block's clutter-map seed threshold
         (step 3b, :mod:`tdm.frontend.radar_extended`): the interior of an echo longer than the range CFAR's
-        window, which masks itself, so that an extended object is one plot. Default False until the whole
-        held-out set is re-run with it (measured on 19 of its 30 runs: 80 -> 85 cells met, none lost; on the
-        tuning scenario's seeds 1-4 one run's false targets rose over the criterion;
-        benchmarks/results/tdm_clutter_map_detection.md).
+        window, which masks itself, so that an extended object is one plot. Default False: on the 30 held-out
+        runs 179 -> 182 cells met (5 gained, 2 lost), but on the tuning scenario's seed 3 the false targets rose
+        over the criterion (benchmarks/results/tdm_clutter_map_detection.md).
     video_threshold_db : float
         Power where video level 1 starts, dB over the mean thermal noise. Default 9.6 dB, the level
         noise alone crosses with probability 1e-4 (``10 log10(-ln 1e-4)``; the IMO Pfa,
