@@ -11,7 +11,7 @@ import numpy as np
 
 from tdm.frontend.radar_config import RadarFrontEndConfig
 
-__all__ = ["LandBlocks", "beam_integrated_power", "clutter_map"]
+__all__ = ["LandBlocks", "beam_integrated_power", "cell_window_power", "clutter_map"]
 
 #: Which clutter-map blocks lie within the beam's smear of the land: called with the (sb, nb) bool blocks to
 #: test, the spokes and the samples per block and the fraction of the beamwidth; returns (sb, nb) bool
@@ -216,6 +216,36 @@ def _annulus_columns_in_range(nb: int, window: tuple[int, int], guard: tuple[int
     return np.count_nonzero((col >= 0) & (col < nb), axis=1).astype(np.int64)
 
 
+def cell_window_power(integrated: np.ndarray, spoke: np.ndarray, sample: np.ndarray,
+                      g: int) -> tuple[np.ndarray, np.ndarray]:
+    """The beam-integrated power of cells: a cell of spoke group k lies in integration windows k - 1 (circular)
+    and k and takes the larger.
+
+    Parameters
+    ----------
+    integrated : (A, N) float32
+        :func:`beam_integrated_power` of the sweep.
+    spoke, sample : (M,) int
+        The cells.
+    g : int
+        Spokes per integration group.
+
+    Returns
+    -------
+    value : (M,) float32
+        The larger window's power, units of the mean noise.
+    row : (M,) int64
+        That window's row of ``integrated``.
+    """
+    a, n_samples = integrated.shape
+    k = spoke // g
+    here_at = k * n_samples + sample
+    before_at = here_at - n_samples  # window k - 1, circular
+    before_at[k == 0] += a * n_samples
+    before, here = integrated.reshape(-1)[before_at], integrated.reshape(-1)[here_at]
+    return np.maximum(before, here), np.where(before > here, (k - 1) % a, k)
+
+
 def _margin_over_clutter_db(lab: np.ndarray, spoke: np.ndarray, sample: np.ndarray, n_labels: int,
                             eligible: np.ndarray, integrated: np.ndarray, g: int,
                             config: RadarFrontEndConfig, land: LandBlocks | None = None) -> np.ndarray:
@@ -230,21 +260,14 @@ def _margin_over_clutter_db(lab: np.ndarray, spoke: np.ndarray, sample: np.ndarr
     :mod:`tdm.frontend.radar_land`).
     """
     margin_db = np.full(n_labels, -np.inf, dtype=np.float32)
-    a, n_samples = integrated.shape
     cells = np.flatnonzero(eligible[lab])
-    k = spoke[cells] // g
-    here_at = k * n_samples + sample[cells]
-    before_at = here_at - n_samples  # window k - 1, circular
-    before_at[k == 0] += a * n_samples
-    before, here = integrated.reshape(-1)[before_at], integrated.reshape(-1)[here_at]
-    value = np.maximum(before, here)
+    value, row = cell_window_power(integrated, spoke[cells], sample[cells], g)
     # only cells above the lowest seed threshold can be a kept plot's peak
     seed = np.flatnonzero(value >= np.float32(10.0 ** (config.min_seed_db / 10.0)))
     if seed.size == 0:
         return margin_db
-    cells, value, k = cells[seed], value[seed], k[seed]
+    cells, value, row = cells[seed], value[seed], row[seed]
     lab_c = lab[cells]
-    row = np.where(before[seed] > here[seed], (k - 1) % a, k)
     peak = np.full(n_labels, -np.inf, dtype=np.float32)
     np.maximum.at(peak, lab_c, value)
     at_peak = np.flatnonzero(value == peak[lab_c])

@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 from tdm.frontend.radar_cfar import _first_valid_sample, _nonzero_flat
-from tdm.frontend.radar_clutter import clutter_map
+from tdm.frontend.radar_clutter import cell_window_power, clutter_map
 from tdm.frontend.radar_config import RadarFrontEndConfig
 
 __all__ = ["clutter_map_cells"]
@@ -48,28 +48,22 @@ def clutter_map_cells(echo: np.ndarray, range_m: np.ndarray, integrated: np.ndar
     Returns
     -------
     (M,) int64
-        Ascending flat indices into ``echo``. A cell of spoke group k lies in integration windows
-        k - 1 and k and takes the larger, as a plot's peak does (step 5).
+        Ascending flat indices into ``echo``. A cell's power is that of the larger of its two integration
+        windows (:func:`tdm.frontend.radar_clutter.cell_window_power`), as a plot's peak's is (step 5).
     """
-    n_spokes, n_samples = echo.shape
+    n_samples = echo.shape[1]
     flat = _nonzero_flat(echo)
     first = _first_valid_sample(range_m, config.blanking_m)
     if first > 0:
         flat = flat[flat % n_samples >= first]
     if flat.size == 0:
         return flat
-    a = integrated.shape[0]
     spoke, sample = np.divmod(flat, n_samples)
-    k = spoke // g
-    here = integrated.reshape(-1)[k * n_samples + sample]
-    before = integrated.reshape(-1)[((k - 1) % a) * n_samples + sample]
-    value = np.maximum(here, before)
-    lowest = np.float32(10.0 ** (config.min_seed_db / 10.0))
-    candidate = np.flatnonzero(value >= lowest)
+    value, row = cell_window_power(integrated, spoke, sample, g)
+    candidate = np.flatnonzero(value >= np.float32(10.0 ** (config.min_seed_db / 10.0)))
     if candidate.size == 0:
         return flat[:0]
     seed = clutter_map(integrated, g, config)
     ba = max(1, config.clutter_block_spokes // g)
-    row = np.where(before[candidate] > here[candidate], (k[candidate] - 1) % a, k[candidate])
-    threshold = seed[row // ba, sample[candidate] // config.clutter_block_samples]
+    threshold = seed[row[candidate] // ba, sample[candidate] // config.clutter_block_samples]
     return flat[candidate[value[candidate] >= threshold]]
