@@ -27,8 +27,10 @@
   fusion with the covariance of a point uniform over the hull added (:func:`tdm.hull.hull_covariance`):
   the fusion leans on the AIS, and its covariance holds the radar's offset. Its LiDAR track lies at the
   middle of the part it sees: uniform over the hull less that part (``hull_sensors``).
-- **Behind the face** (``radar_hidden_depth_*``): a still target's radar track without AIS is put half
-  its plots' core width (or 0.6 of its length where the core width is ill-conditioned) behind its face.
+- **Behind the face** (``radar_hidden_depth_*``; :mod:`tdm.fusion_face`): a still target's radar track without AIS
+  is put half its plots' core width (or 0.6 of its length where the core width is ill-conditioned) behind its face;
+  the radar track of any other target without AIS stays on its face, and that offset is reported in the target's
+  covariance (``consider_radar_face``).
 - **Covariance intersection** (``fusion: ci``), the consistent alternative, with the fast
   weights ``w_i = (1/tr P_i) / sum_j (1/tr P_j)`` (Niehsen 2002):
   ``P^-1 = sum_i w_i P_i^-1``, ``x = P sum_i w_i P_i^-1 x_i``.
@@ -58,13 +60,12 @@ from tdm.fusion_geometry import clearly_apart as _clearly_apart
 from tdm.fusion_geometry import inside_reference as _inside_reference
 from tdm.fusion_geometry import major_variance as _major_variance
 from tdm.fusion_geometry import moves_apart as _moves_apart
+from tdm.fusion_face import STILL_DESCRIPTORS, behind_the_face, face_covariance
 from tdm.fusion_rules import consider_covariance, fuse
 from tdm.fusion_weights import member_hull_covariance, with_extent, with_fragments, with_hull
 from tdm.tracker import Track, predicted_at
 
 
-#: Classes of targets that do not move: an ended one is looked for where it was for ``revive_still_s``.
-STILL_DESCRIPTORS = frozenset({"iceberg", "fixed obstacle"})
 #: Degrees of freedom of the track-to-track gate: east and north position.
 POSITION_DOF = 2
 #: A target is a vessel once it has moved (faster than ``vessel_speed_mps`` by VESSEL_SIGMAS standard
@@ -146,7 +147,7 @@ class Fuser:
         live = {(s, tr.track_id): tr for s, trs in tracks_by_sensor.items() for tr in trs}
         states = dict(zip(live, predicted_at(list(live.values()), t_s)))  # at once; kept for the output
         if own_position_m is not None and cfg.radar_hidden_depth_fraction > 0.0:
-            self._behind_the_face(states, live, np.asarray(own_position_m, dtype=float)[:2])
+            behind_the_face(self.targets, states, live, np.asarray(own_position_m, dtype=float)[:2], cfg)
         # keep members that still exist and stay close to the rest of their target
         claimed: set[tuple[str, int]] = set()
         for target in self.targets:
@@ -202,7 +203,7 @@ class Fuser:
             weigh = with_fragments(weigh, self.targets, cfg.fragment_sensors)
         for target in self.targets:
             x, p = self._estimate(target, weigh)
-            reported_p = self._considered(target, weigh, live, p) if cfg.consider_lidar_extent else p
+            reported_p = self._considered(target, weigh, live, p, own_position_m)
             target.last_x, target.last_t_s, target.radius_m = x, t_s, self._half_length(target, live)
             ais_track = live.get(("ais", target.members.get("ais", -1)))
             target.mmsi = ais_track.mmsi if ais_track is not None else target.mmsi
@@ -303,46 +304,24 @@ class Fuser:
         distance = math.hypot(float(x[0]) - float(own_position_m[0]), float(x[1]) - float(own_position_m[1]))
         return 0.5 * distance * math.radians(beam_deg)
 
-    def _considered(self, target: FusedTarget, states: dict, live: dict, p: np.ndarray) -> np.ndarray:
-        """``p`` (6, 6), the target's fused covariance, with its LiDAR track's extent variance taken through the
-        fusion (``consider_lidar_extent``, :func:`tdm.fusion_rules.consider_covariance`)."""
+    def _considered(self, target: FusedTarget, states: dict, live: dict, p: np.ndarray,
+                    own_position_m: np.ndarray | None) -> np.ndarray:
+        """``p`` (6, 6), the target's fused covariance, with the biases of its members' positions taken through the
+        fusion (:func:`tdm.fusion_rules.consider_covariance`): its LiDAR track's extent variance
+        (``consider_lidar_extent``) and its radar track's face offset (``consider_radar_face``,
+        :func:`tdm.fusion_face.face_covariance`)."""
         keys = list(target.members.items())
-        var = np.array([live[k].extent_var_m2 if k[0] == "lidar" else 0.0 for k in keys])
-        if not np.any(var > 0.0):
+        v = np.zeros((len(keys), 2, 2))
+        for n, key in enumerate(keys):
+            if key[0] == "lidar" and self.config.consider_lidar_extent:
+                v[n] = live[key].extent_var_m2 * np.eye(2)
+            elif key[0] == "radar" and self.config.consider_radar_face:
+                v[n] = face_covariance(target, states[key][0], live[key], own_position_m, self.config)
+        if not np.any(v > 0.0):
             return p
         xs = np.array([states[k][0] for k in keys])
         ps = np.array([states[k][1] for k in keys])
-        return p + consider_covariance(xs, ps, var, self.config.rule)
-
-    def _behind_the_face(self, states: dict, live: dict, own_m: np.ndarray) -> None:
-        """Move the radar tracks of still targets without AIS along the line of sight by their hidden depth, with the
-        variance of that depth added along it (:meth:`_hidden_depth_m`); in ``states``, the tracks themselves
-        untouched."""
-        for target in self.targets:
-            key = ("radar", target.members.get("radar", -1))
-            if target.descriptor not in STILL_DESCRIPTORS or "ais" in target.members or key not in states:
-                continue
-            x, p = states[key]
-            sight = x[:2] - own_m
-            distance = float(np.hypot(*sight))
-            depth_m, sigma_m = self._hidden_depth_m(live[key], distance)
-            if distance > 0.0 and np.isfinite(depth_m):
-                x, p, u = x.copy(), p.copy(), sight / distance
-                x[:2] += depth_m * u
-                p[:2, :2] += sigma_m ** 2 * np.outer(u, u)
-                states[key] = (x, p)
-
-    def _hidden_depth_m(self, track: Track, distance_m: float) -> tuple[float, float]:
-        """How far a still radar track's object's centre lies behind its plots, and that depth's standard deviation,
-        m: fractions of its plots' core width where that spans ``radar_core_width_min_beams`` beamwidths at
-        ``distance_m`` or more (``radar_hidden_depth_size="core_width"``), else of its length."""
-        cfg = self.config
-        core_m, beam_deg = track.core_width_m, cfg.radar_beam_deg
-        if cfg.radar_hidden_depth_size == "core_width" and np.isfinite(core_m) and \
-                core_m >= cfg.radar_core_width_min_beams * distance_m * math.radians(beam_deg or 0.0):
-            return cfg.radar_hidden_depth_fraction * core_m, cfg.radar_hidden_depth_sigma_fraction * core_m
-        return (cfg.radar_hidden_depth_length_fraction * track.length_m,
-                cfg.radar_hidden_depth_length_sigma_fraction * track.length_m)
+        return p + consider_covariance(xs, ps, v, self.config.rule)
 
     def _estimate(self, target: FusedTarget, states) -> tuple[np.ndarray, np.ndarray]:
         """The target's fused state (6,) and covariance (6, 6) from its members' ``states``.

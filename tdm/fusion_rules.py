@@ -55,17 +55,17 @@ def consider_covariance(xs: np.ndarray, ps: np.ndarray, position_var_m2: np.ndar
     Each estimate's position may carry a bias its covariance does not hold (a sensor sees the near side of an
     object: where its centre lies is a slowly changing offset, not noise; a "consider" parameter, as in the
     Schmidt-Kalman filter). The fused state is ``x = sum_k W_k x_k`` with ``W_k = P I_k`` (``I_k`` the k-th
-    estimate's information, times its weight for ``ci``), so independent biases ``b_k`` of variance ``v_k`` per
-    axis (east, north) add ``sum_k v_k W_k[:, :2] W_k[:, :2]^T`` to its covariance; the state itself is
-    not changed.
+    estimate's information, times its weight for ``ci``), so independent biases ``b_k`` of covariance ``V_k``
+    (east, north; ``v_k I`` for a variance ``v_k`` per axis) add ``sum_k W_k[:, :2] V_k W_k[:, :2]^T`` to its
+    covariance; the state itself is not changed.
 
     Parameters
     ----------
     xs : (K, 6) float
     ps : (K, 6, 6) float
         The estimates fused, as given to :func:`fuse`.
-    position_var_m2 : (K,) float
-        Variance of each estimate's position bias per axis, m^2.
+    position_var_m2 : (K,) or (K, 2, 2) float
+        Variance of each estimate's position bias per axis, m^2, or its covariance (east, north), m^2.
     rule : {"simple", "ci"}
 
     Returns
@@ -73,14 +73,16 @@ def consider_covariance(xs: np.ndarray, ps: np.ndarray, position_var_m2: np.ndar
     (6, 6) float
     """
     v = np.asarray(position_var_m2, dtype=float)
+    if v.ndim == 1:
+        v = v[:, None, None] * np.eye(2)
     if len(xs) == 1:
         out = np.zeros((ekf.N_STATES, ekf.N_STATES))
-        out[:2, :2] = v[0] * np.eye(2)
+        out[:2, :2] = v[0]
         return out
     _, ps = canonical_states(xs, ps)
     infos, p = _weighted_informations(ps, rule)
     cols = np.einsum("ij,kjl->kil", p, infos[:, :, :2])  # (K, 6, 2): W_k[:, :2]
-    out = np.einsum("k,kia,kja->ij", v, cols, cols)
+    out = np.einsum("kab,kia,kjb->ij", v, cols, cols)
     return 0.5 * (out + out.T)
 
 

@@ -368,6 +368,55 @@ def test_a_bias_of_one_estimate_reaches_the_fused_covariance_through_its_weight(
     np.testing.assert_allclose(weighted[:2, :2], 25.0 * (4.0 / 20.0) ** 2 * np.eye(2), atol=1e-12)
 
 
+def test_a_bias_along_one_axis_reaches_the_fused_covariance_along_that_axis_only():
+    """A bias covariance (2, 2) per estimate: 16 m^2 north on the first of two equally certain estimates adds
+    16 / 4 m^2 north and nothing east; a per-axis variance v is the matrix v I."""
+    from tdm.fusion_rules import consider_covariance
+
+    p = np.diag([4.0, 4.0, 0.01, 0.25, 1e-4, 100.0])
+    xs = np.array([[0.0, 0.0, 0.1, 5.0, 0.0, 10.0], [1.0, 2.0, 0.1, 5.0, 0.0, 10.0]])
+    v = np.zeros((2, 2, 2))
+    v[0, 1, 1] = 16.0
+    out = consider_covariance(xs, np.array([p, p]), v)
+    np.testing.assert_allclose(out[:2, :2], np.diag([0.0, 4.0]), atol=1e-12)
+    np.testing.assert_allclose(consider_covariance(xs, np.array([p, p]), np.array([9.0, 1.0])),
+                               consider_covariance(xs, np.array([p, p]), np.array([9.0, 1.0])[:, None, None] * np.eye(2)))
+    lone = consider_covariance(xs[:1], np.array([p]), v[:1])
+    np.testing.assert_allclose(lone[:2, :2], np.diag([0.0, 16.0]))
+
+
+@pytest.mark.parametrize("consider", [False, True])
+def test_a_radar_track_left_on_its_face_reports_the_hidden_depth_in_its_covariance_not_its_state(consider):
+    """A radar track 300 m east of the own ship, 12 m long, of a target without AIS not yet classified: reported where
+    it is, with the hidden depth (0.6 x 12 m) squared plus its variance (0.25 x 12 m, squared) added east, along the
+    line of sight, with ``consider_radar_face``; once the target is an iceberg, moved behind its face with only
+    the depth's variance (as before); with an AIS track, nothing added (the hull's spread holds it)."""
+    config = FusionConfig(consider_radar_face=consider)
+    fuser = Fuser(config)
+    radar = make_track(1, "radar", 300.0, 0.0)
+    radar.length_m = 12.0
+    own = np.zeros(2)
+    (first,) = fuser.step(0.0, {"radar": [radar]}, own)
+    depth, sigma = config.radar_hidden_depth_length_fraction * 12.0, config.radar_hidden_depth_length_sigma_fraction * 12.0
+    predicted = radar.predicted(0.0)[1]
+    assert first.x[:2] == pytest.approx([300.0, 0.0])
+    added = np.diag([depth ** 2 + sigma ** 2, 0.0]) if consider else np.zeros((2, 2))
+    assert first.p[:2, :2] == pytest.approx(predicted[:2, :2] + added)
+    assert first.p[2:, 2:] == pytest.approx(predicted[2:, 2:])
+    (no_own,) = fuser.step(0.5, {"radar": [radar]})
+    assert no_own.p[:2, :2] == pytest.approx(radar.predicted(0.5)[1][:2, :2])
+    first.target.descriptor = "iceberg"
+    (still,) = fuser.step(1.0, {"radar": [radar]}, own)
+    assert still.x[:2] == pytest.approx([300.0 + depth, 0.0])
+    assert still.p[:2, :2] == pytest.approx(radar.predicted(1.0)[1][:2, :2] + np.diag([sigma ** 2, 0.0]))
+    ship = Fuser(config)
+    ais = make_track(2, "ais", 300.0, 0.0, mmsi=257000001)
+    (with_ais,) = ship.step(0.0, {"radar": [radar], "ais": [ais]}, own)
+    assert "ais" in with_ais.sources
+    plain = Fuser(FusionConfig(consider_radar_face=False)).step(0.0, {"radar": [radar], "ais": [ais]}, own)[0]
+    assert with_ais.p == pytest.approx(plain.p)
+
+
 @pytest.mark.parametrize("consider", [False, True])
 def test_the_lidars_near_side_offset_is_reported_in_the_covariance_not_the_state(consider):
     """A LiDAR track (var 1 m^2, 10 m long, extent 0.3 of it: 9 m^2 of offset) and a radar track 4 m east (var

@@ -1,0 +1,110 @@
+"""A radar track's painted face and its object's centre behind it (:class:`tdm.fusion.Fuser`).
+
+A radar paints the side of an object that faces it; the track of its plots stands on that face, and the
+object's centre lies behind it along the line of sight by about half the object's size, the *hidden depth*
+(docs/tdm.md, "Extended objects").
+
+- **Still targets without AIS** (``radar_hidden_depth_*``): the radar track is moved its hidden depth behind the
+  face, and the depth's variance is added along the line of sight (:func:`behind_the_face`).
+- **Other targets without AIS** (``consider_radar_face``): the track is left on the face (a ship under way, or a
+  target not yet known to be still), and the offset it carries, the hidden depth squared plus its variance along
+  the line of sight, is reported in the target's covariance as a consider term (:func:`face_covariance`;
+  :func:`tdm.fusion_rules.consider_covariance`), not fed to the fusion's weights or gates.
+
+A target with AIS takes its hull's spread instead (:func:`tdm.fusion_weights.with_hull`).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from tdm.fusion_config import FusionConfig
+from tdm.tracker import Track
+
+if TYPE_CHECKING:  # pragma: no cover
+    from tdm.fusion import FusedTarget
+
+#: Classes of targets that do not move: an ended one is looked for where it was for ``revive_still_s``, and their
+#: radar tracks are moved behind their face.
+STILL_DESCRIPTORS = frozenset({"iceberg", "fixed obstacle"})
+
+
+def hidden_depth_m(track: Track, distance_m: float, config: FusionConfig) -> tuple[float, float]:
+    """How far a radar track's object's centre lies behind its plots, and that depth's standard deviation, m.
+
+    Fractions of its plots' core width where that spans ``radar_core_width_min_beams`` beamwidths at ``distance_m``
+    (m) or more (``radar_hidden_depth_size="core_width"``), else of its length.
+    """
+    core_m, beam_deg = track.core_width_m, config.radar_beam_deg
+    if config.radar_hidden_depth_size == "core_width" and np.isfinite(core_m) and \
+            core_m >= config.radar_core_width_min_beams * distance_m * math.radians(beam_deg or 0.0):
+        return config.radar_hidden_depth_fraction * core_m, config.radar_hidden_depth_sigma_fraction * core_m
+    return (config.radar_hidden_depth_length_fraction * track.length_m,
+            config.radar_hidden_depth_length_sigma_fraction * track.length_m)
+
+
+def behind_the_face(targets: list[FusedTarget], states: dict, live: dict, own_m: np.ndarray,
+                    config: FusionConfig) -> None:
+    """Move the radar tracks of still targets without AIS along the line of sight by their hidden depth.
+
+    Parameters
+    ----------
+    targets : list of FusedTarget
+    states : dict
+        ``(sensor, track id) -> (x (6,), p (6, 6))`` at the step's time; the radar tracks moved are replaced, with
+        the variance of their depth added along the line of sight (the tracks themselves are untouched).
+    live : dict
+        ``(sensor, track id) -> Track``.
+    own_m : (2,) float
+        Own ship's east and north, m.
+    config : FusionConfig
+    """
+    for target in targets:
+        key = ("radar", target.members.get("radar", -1))
+        if target.descriptor not in STILL_DESCRIPTORS or "ais" in target.members or key not in states:
+            continue
+        x, p = states[key]
+        sight = x[:2] - own_m
+        distance = float(np.hypot(*sight))
+        depth_m, sigma_m = hidden_depth_m(live[key], distance, config)
+        if distance > 0.0 and np.isfinite(depth_m):
+            x, p, u = x.copy(), p.copy(), sight / distance
+            x[:2] += depth_m * u
+            p[:2, :2] += sigma_m ** 2 * np.outer(u, u)
+            states[key] = (x, p)
+
+
+def face_covariance(target: FusedTarget, x: np.ndarray, track: Track, own_m: np.ndarray | None,
+                    config: FusionConfig) -> np.ndarray:
+    """Covariance of the offset of a radar track left on its face from its object's centre.
+
+    Parameters
+    ----------
+    target : FusedTarget
+        The track's target.
+    x : (6,) float
+        The track's state at the step's time (position east, north, m).
+    track : Track
+    own_m : (2,) float or None
+        Own ship's east and north, m; None: unknown (zero returned).
+    config : FusionConfig
+
+    Returns
+    -------
+    (2, 2) float
+        m^2: for a target without AIS not known to be still (whose track :func:`behind_the_face` does not move),
+        the hidden depth (:func:`hidden_depth_m`) squared plus its variance, along the line of sight; else zero.
+    """
+    out = np.zeros((2, 2))
+    if own_m is None or "ais" in target.members or target.descriptor in STILL_DESCRIPTORS:
+        return out
+    sight = x[:2] - np.asarray(own_m, dtype=float)[:2]
+    distance = float(np.hypot(*sight))
+    depth_m, sigma_m = hidden_depth_m(track, distance, config)
+    if distance > 0.0 and np.isfinite(depth_m) and np.isfinite(sigma_m):
+        u = sight / distance
+        out = (depth_m ** 2 + sigma_m ** 2) * np.outer(u, u)
+    return out
