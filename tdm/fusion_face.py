@@ -12,6 +12,10 @@ object's centre lies behind it along the line of sight by about half the object'
   :func:`tdm.fusion_rules.consider_covariance`), not fed to the fusion's weights or gates.
 
 A target with AIS takes its hull's spread instead (:func:`tdm.fusion_weights.with_hull`).
+
+- **The radar's own tracks** (``radar_track_face_covariance``): in ``sensor_tracks.jsonl`` each radar track reports
+  the same face offset, along the line of sight, in place of a fraction of its length per axis
+  (:func:`face_report`); it knows nothing of AIS or of being still, so every radar track does.
 """
 
 from __future__ import annotations
@@ -77,6 +81,33 @@ def behind_the_face(targets: list[FusedTarget], states: dict, live: dict, own_m:
             states[key] = (x, p)
 
 
+def face_report(track: Track, t_s: float, own_m: np.ndarray | None, config: FusionConfig
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """What a radar track reports in ``sensor_tracks.jsonl`` at ``t_s`` (s): its predicted state (6,) and covariance
+    (6, 6), with its face offset (:func:`sight_covariance`) added to the position's covariance where
+    ``radar_track_face_covariance`` is on and the own ship's position ``own_m`` (2,) (m) is known, else
+    :meth:`tdm.tracker.Track.reported` (``extent_sigma_fraction`` of its length per axis)."""
+    if not config.radar_track_face_covariance or own_m is None:
+        return track.reported(t_s)
+    x, p = track.predicted(t_s)
+    p = p.copy()
+    p[:2, :2] += sight_covariance(track, x, own_m, config)
+    return x, p
+
+
+def sight_covariance(track: Track, x: np.ndarray, own_m: np.ndarray, config: FusionConfig) -> np.ndarray:
+    """(2, 2) covariance, m^2, of a radar track's offset from its object's centre, along the line of sight from
+    ``own_m`` (2,) to the track's position ``x[:2]`` (m): its hidden depth (:func:`hidden_depth_m`) squared plus
+    the depth's variance; zero where the depth is not finite or the track lies on the own ship."""
+    sight = x[:2] - np.asarray(own_m, dtype=float)[:2]
+    distance = float(np.hypot(*sight))
+    depth_m, sigma_m = hidden_depth_m(track, distance, config)
+    if distance > 0.0 and np.isfinite(depth_m) and np.isfinite(sigma_m):
+        u = sight / distance
+        return (depth_m ** 2 + sigma_m ** 2) * np.outer(u, u)
+    return np.zeros((2, 2))
+
+
 def face_covariance(target: FusedTarget, x: np.ndarray, track: Track, own_m: np.ndarray | None,
                     config: FusionConfig) -> np.ndarray:
     """Covariance of the offset of a radar track left on its face from its object's centre.
@@ -98,13 +129,6 @@ def face_covariance(target: FusedTarget, x: np.ndarray, track: Track, own_m: np.
         m^2: for a target without AIS not known to be still (whose track :func:`behind_the_face` does not move),
         the hidden depth (:func:`hidden_depth_m`) squared plus its variance, along the line of sight; else zero.
     """
-    out = np.zeros((2, 2))
     if own_m is None or "ais" in target.members or target.descriptor in STILL_DESCRIPTORS:
-        return out
-    sight = x[:2] - np.asarray(own_m, dtype=float)[:2]
-    distance = float(np.hypot(*sight))
-    depth_m, sigma_m = hidden_depth_m(track, distance, config)
-    if distance > 0.0 and np.isfinite(depth_m) and np.isfinite(sigma_m):
-        u = sight / distance
-        out = (depth_m ** 2 + sigma_m ** 2) * np.outer(u, u)
-    return out
+        return np.zeros((2, 2))
+    return sight_covariance(track, x, own_m, config)
