@@ -10,12 +10,11 @@ object's centre lies behind it along the line of sight by about half the object'
   target not yet known to be still), and the offset it carries, the hidden depth squared plus its variance along
   the line of sight, is reported in the target's covariance as a consider term (:func:`face_covariance`;
   :func:`tdm.fusion_rules.consider_covariance`), not fed to the fusion's weights or gates.
-
-A target with AIS takes its hull's spread instead (:func:`tdm.fusion_weights.with_hull`).
-
 - **The radar's own tracks** (``radar_track_face_covariance``): in ``sensor_tracks.jsonl`` each radar track reports
   the same face offset, along the line of sight, in place of a fraction of its length per axis
   (:func:`face_report`); it knows nothing of AIS or of being still, so every radar track does.
+
+A target with AIS takes its hull's spread instead (:func:`tdm.fusion_weights.with_hull`).
 """
 
 from __future__ import annotations
