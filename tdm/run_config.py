@@ -70,7 +70,9 @@ class TdmConfig:
         # upwind, which failed on every seed before, rises)
         clutter_extra_hits=1.5, clutter_plots_per_scan=0.1,
         # the reported covariance holds the centre's uncertainty behind the near face, 0.5 of the plots'
-        # extent (busy_open_sea, seed 7, 300 s, 0.3 and 0.5 tried: NEES in its 95 % interval 0.35 -> 0.91)
+        # extent (busy_open_sea, seed 7, 300 s, 0.3 and 0.5 tried: NEES in its 95 % interval 0.35 -> 0.91); since
+        # 2026-11-28 evening sensor_tracks.jsonl takes the face offset along the line of sight instead
+        # (FusionConfig.radar_track_face_covariance), and this holds only where that is off (or weigh_extent is on)
         extent_sigma_fraction=0.5))
     ais_tracker: AisTrackerConfig = field(default_factory=AisTrackerConfig)
     fusion_config: FusionConfig = field(default_factory=FusionConfig)
