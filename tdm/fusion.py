@@ -132,7 +132,8 @@ class Fuser:
         """Associate the confirmed tracks at ``t_s`` and return every target's fused estimate.
 
         ``own_position_m`` (2,), the own ship's east and north at ``t_s`` (m), lets still targets' radar tracks
-        be put behind their painted face (``radar_hidden_depth_fraction``); None: as they are.
+        be put behind their painted face (``radar_hidden_depth_fraction``) and the other radar tracks' face offset be
+        reported along the line of sight (``consider_radar_face``); None: as they are, and no face offset.
         """
         self._memo = {}
         try:

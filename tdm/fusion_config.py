@@ -96,8 +96,8 @@ class FusionConfig:
     # face the radar paints and the object's centre lies about the hidden depth behind it (radar_hidden_depth_*,
     # above), so that depth squared plus its variance, along the line of sight, taken through the fusion's weights
     # as a consider term (tdm/fusion_face.py); the fused state and what the fusion weighs are unchanged. No
-    # parameter fitted; busy_open_sea seeds 1 and 3 (the tuning scenario, 300 s): fused NEES in its interval 0.88 ->
-    # 0.92 on both, every other figure unchanged (docs/tdm.md)
+    # parameter fitted; busy_open_sea seeds 1-7 (the tuning scenario, 300 s): fused NEES in its interval 0.88-0.90 ->
+    # 0.92-0.95, every other figure unchanged (docs/tdm.md)
     consider_radar_face: bool = True
     # sensor_tracks.jsonl: each radar track reports that face offset (the hidden depth squared plus its variance, along
     # the line of sight; tdm/fusion_face.py) in its covariance in place of its TrackerConfig.extent_sigma_fraction

@@ -385,6 +385,23 @@ def test_a_bias_along_one_axis_reaches_the_fused_covariance_along_that_axis_only
     np.testing.assert_allclose(lone[:2, :2], np.diag([0.0, 16.0]))
 
 
+def test_a_bias_across_the_axes_reaches_the_fused_covariance_as_w_v_w_transposed():
+    """Two estimates whose position covariances do not commute, a bias along 45 deg on the first: the term is
+    W_1[:, :2] V W_1[:, :2]^T with W_1 = P P_1^-1 (off-diagonal terms of V kept)."""
+    from tdm.fusion_rules import consider_covariance
+
+    p1 = np.diag([4.0, 1.0, 0.01, 0.25, 1e-4, 100.0])
+    p2 = p1.copy()
+    p2[:2, :2] = [[2.0, 1.5], [1.5, 5.0]]
+    xs = np.array([[0.0, 0.0, 0.1, 5.0, 0.0, 10.0], [1.0, 2.0, 0.1, 5.0, 0.0, 10.0]])
+    u = np.array([1.0, 1.0]) / np.sqrt(2.0)
+    v = np.zeros((2, 2, 2))
+    v[0] = 25.0 * np.outer(u, u)
+    p = np.linalg.inv(np.linalg.inv(p1) + np.linalg.inv(p2))
+    w1 = (p @ np.linalg.inv(p1))[:, :2]
+    np.testing.assert_allclose(consider_covariance(xs, np.array([p1, p2]), v), w1 @ v[0] @ w1.T, atol=1e-12)
+
+
 @pytest.mark.parametrize("consider", [False, True])
 def test_a_radar_track_left_on_its_face_reports_the_hidden_depth_in_its_covariance_not_its_state(consider):
     """A radar track 300 m east of the own ship, 12 m long, of a target without AIS not yet classified: reported where
