@@ -70,11 +70,9 @@ def behind_the_face(targets: list[FusedTarget], states: dict, live: dict, own_m:
         if target.descriptor not in STILL_DESCRIPTORS or "ais" in target.members or key not in states:
             continue
         x, p = states[key]
-        sight = x[:2] - own_m
-        distance = float(np.hypot(*sight))
-        depth_m, sigma_m = hidden_depth_m(live[key], distance, config)
-        if distance > 0.0 and np.isfinite(depth_m):
-            x, p, u = x.copy(), p.copy(), sight / distance
+        u, depth_m, sigma_m = _sight_and_depth(live[key], x, own_m, config)
+        if u is not None and np.isfinite(depth_m):
+            x, p = x.copy(), p.copy()
             x[:2] += depth_m * u
             p[:2, :2] += sigma_m ** 2 * np.outer(u, u)
             states[key] = (x, p)
@@ -98,13 +96,21 @@ def sight_covariance(track: Track, x: np.ndarray, own_m: np.ndarray, config: Fus
     """(2, 2) covariance, m^2, of a radar track's offset from its object's centre, along the line of sight from
     ``own_m`` (2,) to the track's position ``x[:2]`` (m): its hidden depth (:func:`hidden_depth_m`) squared plus
     the depth's variance; zero where the depth is not finite or the track lies on the own ship."""
+    u, depth_m, sigma_m = _sight_and_depth(track, x, own_m, config)
+    if u is not None and np.isfinite(depth_m) and np.isfinite(sigma_m):
+        return (depth_m ** 2 + sigma_m ** 2) * np.outer(u, u)
+    return np.zeros((2, 2))
+
+
+def _sight_and_depth(track: Track, x: np.ndarray, own_m: np.ndarray, config: FusionConfig
+                     ) -> tuple[np.ndarray | None, float, float]:
+    """The unit line of sight (2,) from ``own_m`` (2,, m) to the track's position ``x[:2]`` (m), None where the
+    track lies on the own ship, and the track's hidden depth and its standard deviation there, m
+    (:func:`hidden_depth_m`)."""
     sight = x[:2] - np.asarray(own_m, dtype=float)[:2]
     distance = float(np.hypot(*sight))
     depth_m, sigma_m = hidden_depth_m(track, distance, config)
-    if distance > 0.0 and np.isfinite(depth_m) and np.isfinite(sigma_m):
-        u = sight / distance
-        return (depth_m ** 2 + sigma_m ** 2) * np.outer(u, u)
-    return np.zeros((2, 2))
+    return (sight / distance if distance > 0.0 else None), depth_m, sigma_m
 
 
 def face_covariance(target: FusedTarget, x: np.ndarray, track: Track, own_m: np.ndarray | None,
