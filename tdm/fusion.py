@@ -133,9 +133,13 @@ class Fuser:
 
         ``own_position_m`` (2,), the own ship's east and north at ``t_s`` (m), lets still targets' radar tracks
         be put behind their painted face (``radar_hidden_depth_fraction``) and the other radar tracks' face offset be
-        reported along the line of sight (``consider_radar_face``); None: as they are, and no face offset.
+        reported along the line of sight (``consider_radar_face``); None or not finite: as they are, and no face
+        offset.
         """
         self._memo = {}
+        if own_position_m is not None:
+            own_position_m = np.asarray(own_position_m, dtype=float)[:2]
+            own_position_m = own_position_m if np.all(np.isfinite(own_position_m)) else None
         try:
             return self._step(t_s, tracks_by_sensor, own_position_m)
         finally:
@@ -147,8 +151,9 @@ class Fuser:
         cfg = self.config
         live = {(s, tr.track_id): tr for s, trs in tracks_by_sensor.items() for tr in trs}
         states = dict(zip(live, predicted_at(list(live.values()), t_s)))  # at once; kept for the output
+        moved = set()
         if own_position_m is not None and cfg.radar_hidden_depth_fraction > 0.0:
-            behind_the_face(self.targets, states, live, np.asarray(own_position_m, dtype=float)[:2], cfg)
+            moved = behind_the_face(self.targets, states, live, own_position_m, cfg)
         # keep members that still exist and stay close to the rest of their target
         claimed: set[tuple[str, int]] = set()
         for target in self.targets:
@@ -204,7 +209,7 @@ class Fuser:
             weigh = with_fragments(weigh, self.targets, cfg.fragment_sensors)
         for target in self.targets:
             x, p = self._estimate(target, weigh)
-            reported_p = self._considered(target, weigh, live, p, own_position_m)
+            reported_p = self._considered(target, weigh, live, p, own_position_m, moved)
             target.last_x, target.last_t_s, target.radius_m = x, t_s, self._half_length(target, live)
             ais_track = live.get(("ais", target.members.get("ais", -1)))
             target.mmsi = ais_track.mmsi if ais_track is not None else target.mmsi
@@ -306,18 +311,19 @@ class Fuser:
         return 0.5 * distance * math.radians(beam_deg)
 
     def _considered(self, target: FusedTarget, states: dict, live: dict, p: np.ndarray,
-                    own_position_m: np.ndarray | None) -> np.ndarray:
+                    own_position_m: np.ndarray | None, moved: set) -> np.ndarray:
         """``p`` (6, 6), the target's fused covariance, with the biases of its members' positions taken through the
         fusion (:func:`tdm.fusion_rules.consider_covariance`): its LiDAR track's extent variance
         (``consider_lidar_extent``) and its radar track's face offset (``consider_radar_face``,
-        :func:`tdm.fusion_face.face_covariance`)."""
+        :func:`tdm.fusion_face.face_covariance`) unless the track is one of ``moved``, those
+        :func:`tdm.fusion_face.behind_the_face` put behind their face this step."""
         keys = list(target.members.items())
         v = np.zeros((len(keys), 2, 2))
         for n, key in enumerate(keys):
             if key[0] == "lidar" and self.config.consider_lidar_extent:
                 v[n] = live[key].extent_var_m2 * np.eye(2)
             elif key[0] == "radar" and self.config.consider_radar_face:
-                v[n] = face_covariance(target, states[key][0], live[key], own_position_m, self.config)
+                v[n] = face_covariance(target, key in moved, states[key][0], live[key], own_position_m, self.config)
         if not np.any(v > 0.0):
             return p
         xs = np.array([states[k][0] for k in keys])

@@ -6,8 +6,8 @@ object's centre lies behind it along the line of sight by about half the object'
 
 - **Still targets without AIS** (``radar_hidden_depth_*``): the radar track is moved its hidden depth behind the
   face, and the depth's variance is added along the line of sight (:func:`behind_the_face`).
-- **Other targets without AIS** (``consider_radar_face``): the track is left on the face (a ship under way, or a
-  target not yet known to be still), and the offset it carries, the hidden depth squared plus its variance along
+- **Other targets without AIS** (``consider_radar_face``): the track is left on the face (a ship under way, a
+  target not yet known to be still, or a track that joined a still target during the step), and the offset it carries, the hidden depth squared plus its variance along
   the line of sight, is reported in the target's covariance as a consider term (:func:`face_covariance`;
   :func:`tdm.fusion_rules.consider_covariance`), not fed to the fusion's weights or gates.
 - **The radar's own tracks** (``radar_track_face_covariance``): in ``sensor_tracks.jsonl`` each radar track reports
@@ -50,7 +50,7 @@ def hidden_depth_m(track: Track, distance_m: float, config: FusionConfig) -> tup
 
 
 def behind_the_face(targets: list[FusedTarget], states: dict, live: dict, own_m: np.ndarray,
-                    config: FusionConfig) -> None:
+                    config: FusionConfig) -> set[tuple[str, int]]:
     """Move the radar tracks of still targets without AIS along the line of sight by their hidden depth.
 
     Parameters
@@ -64,7 +64,14 @@ def behind_the_face(targets: list[FusedTarget], states: dict, live: dict, own_m:
     own_m : (2,) float
         Own ship's east and north, m.
     config : FusionConfig
+
+    Returns
+    -------
+    set of (str, int)
+        The keys of the radar tracks moved: their depth is in their state, not to be reported again by
+        :func:`face_covariance` whatever target they end the step in.
     """
+    moved: set[tuple[str, int]] = set()
     for target in targets:
         key = ("radar", target.members.get("radar", -1))
         if target.descriptor not in STILL_DESCRIPTORS or "ais" in target.members or key not in states:
@@ -76,15 +83,17 @@ def behind_the_face(targets: list[FusedTarget], states: dict, live: dict, own_m:
             x[:2] += depth_m * u
             p[:2, :2] += sigma_m ** 2 * np.outer(u, u)
             states[key] = (x, p)
+            moved.add(key)
+    return moved
 
 
 def face_report(track: Track, t_s: float, own_m: np.ndarray | None, config: FusionConfig
                 ) -> tuple[np.ndarray, np.ndarray]:
     """What a radar track reports in ``sensor_tracks.jsonl`` at ``t_s`` (s): its predicted state (6,) and covariance
     (6, 6), with its face offset (:func:`sight_covariance`) added to the position's covariance where
-    ``radar_track_face_covariance`` is on and the own ship's position ``own_m`` (2,) (m) is known, else
+    ``radar_track_face_covariance`` is on and the own ship's position ``own_m`` (2,) (m) is known (not None, finite), else
     :meth:`tdm.tracker.Track.reported` (``extent_sigma_fraction`` of its length per axis)."""
-    if not config.radar_track_face_covariance or own_m is None:
+    if not config.radar_track_face_covariance or own_m is None or not np.all(np.isfinite(own_m)):
         return track.reported(t_s)
     x, p = track.predicted(t_s)
     p = p.copy()
@@ -113,14 +122,16 @@ def _sight_and_depth(track: Track, x: np.ndarray, own_m: np.ndarray, config: Fus
     return (sight / distance if distance > 0.0 else None), depth_m, sigma_m
 
 
-def face_covariance(target: FusedTarget, x: np.ndarray, track: Track, own_m: np.ndarray | None,
+def face_covariance(target: FusedTarget, moved: bool, x: np.ndarray, track: Track, own_m: np.ndarray | None,
                     config: FusionConfig) -> np.ndarray:
     """Covariance of the offset of a radar track left on its face from its object's centre.
 
     Parameters
     ----------
     target : FusedTarget
-        The track's target.
+        The track's target at the end of the step.
+    moved : bool
+        Whether :func:`behind_the_face` moved the track at the start of the step (its depth is in its state).
     x : (6,) float
         The track's state at the step's time (position east, north, m).
     track : Track
@@ -131,9 +142,11 @@ def face_covariance(target: FusedTarget, x: np.ndarray, track: Track, own_m: np.
     Returns
     -------
     (2, 2) float
-        m^2: for a target without AIS not known to be still (whose track :func:`behind_the_face` does not move),
-        the hidden depth (:func:`hidden_depth_m`) squared plus its variance, along the line of sight; else zero.
+        m^2: for a track not moved, of a target without AIS, the hidden depth (:func:`hidden_depth_m`) squared plus
+        its variance, along the line of sight; else zero. Membership is that at the end of the step: a track that
+        joined a still target during it is widened, not left bare, and one moved at the start and then merged into
+        a vessel's target is not widened again.
     """
-    if own_m is None or "ais" in target.members or target.descriptor in STILL_DESCRIPTORS:
+    if own_m is None or moved or "ais" in target.members:
         return np.zeros((2, 2))
     return sight_covariance(track, x, own_m, config)

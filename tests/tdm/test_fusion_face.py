@@ -49,3 +49,10 @@ def test_a_radar_track_reports_its_face_offset_in_place_of_a_fraction_of_its_len
     assert p[2:, 2:] == pytest.approx(p_pred[2:, 2:])
     unknown_own = face_report(track, 2.0, None, config)[1]
     assert unknown_own == pytest.approx(track.reported(2.0)[1])
+
+
+def test_a_radar_track_with_an_own_position_not_finite_reports_as_without_one():
+    config = FusionConfig()
+    track = radar_track(500.0, 0.0, core_width_m=55.0)
+    x, p = face_report(track, 2.0, np.array([np.nan, 0.0]), config)
+    assert p == pytest.approx(track.reported(2.0)[1]) and x == pytest.approx(track.reported(2.0)[0])

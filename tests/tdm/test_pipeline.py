@@ -222,3 +222,43 @@ def test_the_detection_stream_is_in_time_order_and_complete(bos_recording, worke
     # the sensors are interleaved, not one after the other
     first_radar = sensors.index("radar")
     assert sensors[first_radar + 1:].count("lidar") > 0.8 * sensors.count("lidar")
+
+
+def test_radar_tracks_report_their_face_offset_along_the_line_of_sight_from_the_own_ship(busy, tmp_path):
+    """sensor_tracks.jsonl with ``radar_track_face_covariance`` (the default) against without it: the same positions;
+    each radar track's covariance differs by a u^T (the face offset along the line of sight u from the own ship at
+    that epoch) minus b I (the 0.5 x length per axis it replaces), so the difference's larger eigenvector points
+    along u and its other eigenvalue is not positive."""
+    from groundfloor.frames import LocalFrame
+    from tdm.fusion import FusionConfig
+    from tdm.pipeline import run_tdm
+    from tdm.run_config import TdmConfig
+
+    rec, _ = busy
+    off = TdmConfig.for_recording(rec, fusion_config=FusionConfig(radar_track_face_covariance=False))
+    run_tdm(rec, tmp_path / "off", off)
+
+    def radar_rows(path: Path) -> dict:
+        rows = (json.loads(line) for line in path.read_text().splitlines())
+        return {(r["t"], r["target_id"]): r for r in rows if r["sensor"] == "radar"}
+
+    on_rows, off_rows = radar_rows(rec / "tdm" / "sensor_tracks.jsonl"), radar_rows(tmp_path / "off" / "sensor_tracks.jsonl")
+    assert on_rows.keys() == off_rows.keys() and len(on_rows) > 20
+    own = [json.loads(line) for line in (rec / "ownship.jsonl").read_text().splitlines()]
+    own_t = np.array([o["t"] for o in own])
+    frame = LocalFrame(own[0]["lat"], own[0]["lon"])
+    aligned = 0
+    for key, on in on_rows.items():
+        off_row = off_rows[key]
+        assert (on["latitude"], on["longitude"]) == (off_row["latitude"], off_row["longitude"])
+        d = np.array(on["position_cov_m2"]) - np.array(off_row["position_cov_m2"])
+        values, vectors = np.linalg.eigh(d)
+        i = int(np.argmin(np.abs(own_t - key[0])))
+        e, n = frame.to_local(np.array([on["latitude"], own[i]["lat"]]), np.array([on["longitude"], own[i]["lon"]]))
+        u = np.array([e[0] - e[1], n[0] - n[1]])
+        u /= np.hypot(*u)
+        assert values[0] <= 1e-3
+        if values[1] - values[0] > 1.0:  # the offset is not lost in the rounding
+            assert abs(vectors[:, 1] @ u) > np.cos(np.radians(1.0)), key
+            aligned += 1
+    assert aligned > 0.5 * len(on_rows)
