@@ -62,6 +62,7 @@ from tdm.fusion_geometry import major_variance as _major_variance
 from tdm.fusion_geometry import moves_apart as _moves_apart
 from tdm.fusion_face import STILL_DESCRIPTORS, behind_the_face, face_covariance
 from tdm.fusion_rules import consider_covariance, fuse
+from tdm.nav_bias import NAV_RELATIVE_SENSORS, nav_bias_covariance
 from tdm.fusion_weights import member_hull_covariance, with_extent, with_fragments, with_hull
 from tdm.tracker import Track, predicted_at
 
@@ -314,21 +315,28 @@ class Fuser:
                     own_position_m: np.ndarray | None, moved: set) -> np.ndarray:
         """``p`` (6, 6), the target's fused covariance, with the biases of its members' positions taken through the
         fusion (:func:`tdm.fusion_rules.consider_covariance`): its LiDAR track's extent variance
-        (``consider_lidar_extent``) and its radar track's face offset (``consider_radar_face``,
+        (``consider_lidar_extent``), its radar track's face offset (``consider_radar_face``,
         :func:`tdm.fusion_face.face_covariance`) unless the track is one of ``moved``, those
-        :func:`tdm.fusion_face.behind_the_face` put behind their face this step."""
+        :func:`tdm.fusion_face.behind_the_face` put behind their face this step, and the own ship's navigation bias
+        that its LiDAR and radar tracks share (``consider_nav_bias``, :mod:`tdm.nav_bias`)."""
+        cfg = self.config
         keys = list(target.members.items())
         v = np.zeros((len(keys), 2, 2))
         for n, key in enumerate(keys):
-            if key[0] == "lidar" and self.config.consider_lidar_extent:
+            if key[0] == "lidar" and cfg.consider_lidar_extent:
                 v[n] = live[key].extent_var_m2 * np.eye(2)
-            elif key[0] == "radar" and self.config.consider_radar_face:
-                v[n] = face_covariance(target, key in moved, states[key][0], live[key], own_position_m, self.config)
-        if not np.any(v > 0.0):
+            elif key[0] == "radar" and cfg.consider_radar_face:
+                v[n] = face_covariance(target, key in moved, states[key][0], live[key], own_position_m, cfg)
+        shared = np.array([key[0] in NAV_RELATIVE_SENSORS for key in keys])
+        nav = None
+        if cfg.consider_nav_bias and shared.any():
+            x, _ = self._estimate(target, states)
+            nav = nav_bias_covariance(x[:2], own_position_m, cfg.nav_position_bias_m, cfg.nav_heading_bias_deg)
+        if not np.any(v > 0.0) and (nav is None or not np.any(nav > 0.0)):
             return p
         xs = np.array([states[k][0] for k in keys])
         ps = np.array([states[k][1] for k in keys])
-        return p + consider_covariance(xs, ps, v, self.config.rule)
+        return p + consider_covariance(xs, ps, v, cfg.rule, nav, shared)
 
     def _estimate(self, target: FusedTarget, states) -> tuple[np.ndarray, np.ndarray]:
         """The target's fused state (6,) and covariance (6, 6) from its members' ``states``.

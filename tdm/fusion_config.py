@@ -132,6 +132,15 @@ class FusionConfig:
     # harbour_approach's anchored and moored ships' targets (seed 31's error beyond LiDAR range 6.7 -> 8.7 m). Both
     # found on held-out runs (docs/tdm.md)
     release_beyond_ais_spread: bool = True
+    # report every position measured from the own ship (LiDAR and radar tracks in sensor_tracks.jsonl, and through
+    # the fusion's weights the targets) with the own ship's navigation bias in its covariance (tdm/nav_bias.py): a
+    # GNSS position bias and a heading bias that change over minutes are shared by every scan of a track, so the
+    # filters, which take each scan's error as independent, do not hold them. The standard deviations are the
+    # recording's (scenario.yaml sensors.nav.position_bias_m and heading_bias_deg: TdmConfig.for_recording; these
+    # defaults are raysim's); a user states their own GNSS and compass. Nothing fitted
+    consider_nav_bias: bool = True
+    nav_position_bias_m: float = 0.5
+    nav_heading_bias_deg: float = 0.1
 
     def __post_init__(self):
         if self.radar_hidden_depth_size not in ("core_width", "length"):
@@ -141,5 +150,8 @@ class FusionConfig:
             unknown = sorted(set(getattr(self, name)) - set(TRACK_SENSORS))
             if unknown:
                 raise ValueError(f"{name}: unknown sensor {unknown[0]!r} (one of {', '.join(TRACK_SENSORS)})")
+        for name in ("nav_position_bias_m", "nav_heading_bias_deg"):
+            if not 0.0 <= getattr(self, name) < float("inf"):
+                raise ValueError(f"{name} must be finite and >= 0, not {getattr(self, name)}")
         if not self.promote_after_s >= 0.0:
             raise ValueError(f"promote_after_s must be >= 0, not {self.promote_after_s}")

@@ -12,7 +12,8 @@ object's centre lies behind it along the line of sight by about half the object'
   :func:`tdm.fusion_rules.consider_covariance`), not fed to the fusion's weights or gates.
 - **The radar's own tracks** (``radar_track_face_covariance``): in ``sensor_tracks.jsonl`` each radar track reports
   the same face offset, along the line of sight, in place of a fraction of its length per axis
-  (:func:`face_report`); it knows nothing of AIS or of being still, so every radar track does.
+  (:func:`face_report`); it knows nothing of AIS or of being still, so every radar track does. A LiDAR or radar
+  track reports the own ship's navigation bias too (:func:`sensor_report`, :mod:`tdm.nav_bias`).
 
 A target with AIS takes its hull's spread instead (:func:`tdm.fusion_weights.with_hull`).
 """
@@ -25,6 +26,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from tdm.fusion_config import FusionConfig
+from tdm.nav_bias import NAV_RELATIVE_SENSORS, nav_bias_covariance
 from tdm.tracker import Track
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -98,6 +100,19 @@ def face_report(track: Track, t_s: float, own_m: np.ndarray | None, config: Fusi
     x, p = track.predicted(t_s)
     p = p.copy()
     p[:2, :2] += sight_covariance(track, x, own_m, config)
+    return x, p
+
+
+def sensor_report(sensor: str, track: Track, t_s: float, own_m: np.ndarray | None, config: FusionConfig
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """What a track of ``sensor`` reports in ``sensor_tracks.jsonl`` at ``t_s`` (s): its state (6,) and covariance
+    (6, 6); a radar track's as :func:`face_report`, another's as :meth:`tdm.tracker.Track.reported`, and with the
+    own ship's navigation bias added to a LiDAR or radar track's position covariance (``consider_nav_bias``,
+    :func:`tdm.nav_bias.nav_bias_covariance`; ``own_m`` (2,) m, the own ship's position, None if unknown)."""
+    x, p = face_report(track, t_s, own_m, config) if sensor == "radar" else track.reported(t_s)
+    if config.consider_nav_bias and sensor in NAV_RELATIVE_SENSORS:
+        p = p.copy()
+        p[:2, :2] += nav_bias_covariance(x[:2], own_m, config.nav_position_bias_m, config.nav_heading_bias_deg)
     return x, p
 
 

@@ -48,8 +48,8 @@ def _weighted_informations(ps: np.ndarray, rule: str) -> tuple[np.ndarray, np.nd
     return infos, np.linalg.inv(infos.sum(axis=0))
 
 
-def consider_covariance(xs: np.ndarray, ps: np.ndarray, position_var_m2: np.ndarray, rule: str = "simple"
-                        ) -> np.ndarray:
+def consider_covariance(xs: np.ndarray, ps: np.ndarray, position_var_m2: np.ndarray, rule: str = "simple",
+                        shared_var_m2: np.ndarray | None = None, shared: np.ndarray | None = None) -> np.ndarray:
     """Covariance of the error a fusion (:func:`fuse`) takes over from biases of its estimates' positions.
 
     Each estimate's position may carry a bias its covariance does not hold (a sensor sees the near side of an
@@ -57,7 +57,9 @@ def consider_covariance(xs: np.ndarray, ps: np.ndarray, position_var_m2: np.ndar
     Schmidt-Kalman filter). The fused state is ``x = sum_k W_k x_k`` with ``W_k = P I_k`` (``I_k`` the k-th
     estimate's information, times its weight for ``ci``), so independent biases ``b_k`` of covariance ``V_k``
     (east, north; ``v_k I`` for a variance ``v_k`` per axis) add ``sum_k W_k[:, :2] V_k W_k[:, :2]^T`` to its
-    covariance; the state itself is not changed.
+    covariance, and one bias ``b`` of covariance ``C`` shared by the estimates in ``shared`` (the own ship's
+    navigation error in every track measured from it, :mod:`tdm.nav_bias`) adds ``S C S^T``, ``S = sum_shared
+    W_k[:, :2]``; the state itself is not changed.
 
     Parameters
     ----------
@@ -67,6 +69,10 @@ def consider_covariance(xs: np.ndarray, ps: np.ndarray, position_var_m2: np.ndar
     position_var_m2 : (K,) or (K, 2, 2) float
         Variance of each estimate's position bias per axis, m^2, or its covariance (east, north), m^2.
     rule : {"simple", "ci"}
+    shared_var_m2 : (2, 2) float, optional
+        Covariance of the shared bias, m^2; None: none.
+    shared : (K,) bool, optional
+        Which estimates carry the shared bias; None: all.
 
     Returns
     -------
@@ -75,14 +81,18 @@ def consider_covariance(xs: np.ndarray, ps: np.ndarray, position_var_m2: np.ndar
     v = np.asarray(position_var_m2, dtype=float)
     if v.ndim == 1:
         v = v[:, None, None] * np.eye(2)
+    mask = np.ones(len(xs), dtype=bool) if shared is None else np.asarray(shared, dtype=bool)
     if len(xs) == 1:
         out = np.zeros((ekf.N_STATES, ekf.N_STATES))
-        out[:2, :2] = v[0]
+        out[:2, :2] = v[0] + (shared_var_m2 if shared_var_m2 is not None and mask[0] else 0.0)
         return out
     _, ps = canonical_states(xs, ps)
     infos, p = _weighted_informations(ps, rule)
     cols = np.einsum("ij,kjl->kil", p, infos[:, :, :2])  # (K, 6, 2): W_k[:, :2]
     out = np.einsum("kab,kia,kjb->ij", v, cols, cols)
+    if shared_var_m2 is not None and mask.any():
+        s = cols[mask].sum(axis=0)  # (6, 2)
+        out = out + s @ np.asarray(shared_var_m2, dtype=float) @ s.T
     return 0.5 * (out + out.T)
 
 

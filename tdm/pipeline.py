@@ -35,7 +35,7 @@ from tdm import ekf
 from tdm.detections import ReadStats
 from tdm.errors import RecordingError
 from tdm.fusion import Fuser, FusionConfig
-from tdm.fusion_face import face_report
+from tdm.fusion_face import sensor_report
 from tdm.io import read_manifest, read_scenario
 from tdm.land import LandMask
 from tdm.messages import jsonl_writer, target_records
@@ -132,7 +132,7 @@ class _Tracking:
         tracks = []
         for sensor, trs in by_sensor.items():
             for tr in trs:
-                x, p = face_report(tr, t_out, own, self.fuser.config) if sensor == "radar" else tr.reported(t_out)
+                x, p = sensor_report(sensor, tr, t_out, own, self.fuser.config)
                 if self.on_land(x):
                     continue
                 tracks.append((tr.track_id, descriptors.get((sensor, tr.track_id), "unknown"), x, p, [sensor], tr.mmsi,

@@ -6,7 +6,7 @@ Read by the run (:mod:`tdm.pipeline`) and its scan sources (:mod:`tdm.scans`); i
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from tdm.fusion import FusionConfig
@@ -79,6 +79,21 @@ class TdmConfig:
 
     @classmethod
     def for_recording(cls, recording: Path, **changes) -> "TdmConfig":
-        """The defaults with ``update_rate_hz`` from the recording's scenario.yaml, then ``changes``."""
-        rate = float((read_scenario(recording).get("tdm") or {}).get("update_rate_hz", DEFAULT_UPDATE_RATE_HZ))
-        return cls(**{"update_rate_hz": rate, **changes})
+        """The defaults with ``update_rate_hz`` and the own ship's navigation bias (``sensors.nav.position_bias_m``,
+        ``heading_bias_deg``: :attr:`FusionConfig.nav_position_bias_m`) from the recording's scenario.yaml, then
+        ``changes``."""
+        scenario = read_scenario(recording)
+        rate = float((scenario.get("tdm") or {}).get("update_rate_hz", DEFAULT_UPDATE_RATE_HZ))
+        return cls(**{"update_rate_hz": rate, "fusion_config": _with_nav_bias(FusionConfig(), scenario), **changes})
+
+
+def _with_nav_bias(config: FusionConfig, scenario: dict) -> FusionConfig:
+    """``config`` with the navigation bias the scenario states (``sensors.nav``; checked by
+    :func:`tdm.io.read_scenario`); a disabled or absent nav keeps the defaults."""
+    nav = (scenario.get("sensors") or {}).get("nav") or {}
+    if not nav.get("enabled", True):
+        return config
+    values = {field_name: float(nav[key]) for field_name, key in (("nav_position_bias_m", "position_bias_m"),
+                                                                  ("nav_heading_bias_deg", "heading_bias_deg"))
+              if nav.get(key) is not None}
+    return replace(config, **values)

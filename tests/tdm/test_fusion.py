@@ -63,7 +63,7 @@ def test_a_still_targets_radar_track_is_put_its_hidden_depth_behind_the_face_alo
     """A berg's radar track 500 m north of the own ship, 12 m long (no core width: its length is its size): reported
     ``radar_hidden_depth_length_fraction`` x 12 m farther north once the target is still (an iceberg); a vessel's,
     or a track with AIS, as it is."""
-    fuser = Fuser(FusionConfig())
+    fuser = Fuser(FusionConfig(consider_nav_bias=False))
     radar = make_track(1, "radar", 0.0, 500.0)
     radar.length_m = 12.0
     own = np.array([0.0, 0.0])
@@ -71,9 +71,9 @@ def test_a_still_targets_radar_track_is_put_its_hidden_depth_behind_the_face_alo
     assert first.x[:2] == pytest.approx([0.0, 500.0])  # not yet known to be still
     first.target.descriptor = "iceberg"
     (still,) = fuser.step(1.0, {"radar": [radar]}, own)
-    depth = FusionConfig().radar_hidden_depth_length_fraction * 12.0
+    depth = FusionConfig(consider_nav_bias=False).radar_hidden_depth_length_fraction * 12.0
     assert depth > 0.0 and still.x[:2] == pytest.approx([0.0, 500.0 + depth])
-    sigma = FusionConfig().radar_hidden_depth_length_sigma_fraction * 12.0  # the depth's uncertainty, along the sight line
+    sigma = FusionConfig(consider_nav_bias=False).radar_hidden_depth_length_sigma_fraction * 12.0  # the depth's uncertainty, along the sight line
     predicted = radar.predicted(1.0)[1][:2, :2]
     assert still.p[:2, :2] == pytest.approx(predicted + np.diag([0.0, sigma**2]))
     assert radar.x[:2] == pytest.approx([0.0, 500.0])  # the track itself is untouched
@@ -91,7 +91,7 @@ def test_the_hidden_depth_is_a_fraction_of_the_core_width_where_the_object_spans
     with ``radar_hidden_depth_size="length"`` the length rule holds everywhere."""
     for size, north_m, by_core in (("core_width", 500.0, True), ("core_width", 2000.0, False),
                                    ("length", 500.0, False)):
-        config = FusionConfig(radar_hidden_depth_size=size)
+        config = FusionConfig(consider_nav_bias=False, radar_hidden_depth_size=size)
         fuser = Fuser(config)
         radar = make_track(1, "radar", 0.0, north_m)
         radar.length_m, radar.core_width_m = 12.0, 55.0
@@ -104,7 +104,7 @@ def test_the_hidden_depth_is_a_fraction_of_the_core_width_where_the_object_spans
         assert still.x[:2] == pytest.approx([0.0, north_m + depth_m])
         assert still.p[1, 1] == pytest.approx(radar.predicted(1.0)[1][1, 1] + sigma_m ** 2)
     with pytest.raises(ValueError, match="radar_hidden_depth_size"):
-        FusionConfig(radar_hidden_depth_size="width")
+        FusionConfig(consider_nav_bias=False, radar_hidden_depth_size="width")
 
 
 @pytest.mark.parametrize("field", ["join_free_slot", "hull_sensors", "fragment_sensors"])
@@ -231,7 +231,7 @@ def test_a_ship_passing_close_to_a_still_berg_does_not_swallow_it():
 def test_the_centres_uncertainty_weighs_the_output_only_when_asked(weigh):
     """A LiDAR track (var 1 m^2) and a radar track 4 m east (var 4 m^2, 12 m long, extent 0.5 of it: +36 m^2):
     by default the fusion weighs the filters' covariances (1 : 4); with ``weigh_extent`` the radar's 40 m^2."""
-    fuser = Fuser(FusionConfig(weigh_extent=weigh))
+    fuser = Fuser(FusionConfig(consider_nav_bias=False, weigh_extent=weigh))
     lidar = make_track(1, "lidar", 0.0, 100.0, var=1.0)
     radar = make_track(2, "radar", 4.0, 100.0, var=4.0)
     radar.length_m, radar.extent_sigma_fraction = 12.0, 0.5
@@ -408,7 +408,7 @@ def test_a_radar_track_left_on_its_face_reports_the_hidden_depth_in_its_covarian
     it is, with the hidden depth (0.6 x 12 m) squared plus its variance (0.25 x 12 m, squared) added east, along the
     line of sight, with ``consider_radar_face``; once the target is an iceberg, moved behind its face with only
     the depth's variance (as before); with an AIS track, nothing added (the hull's spread holds it)."""
-    config = FusionConfig(consider_radar_face=consider)
+    config = FusionConfig(consider_nav_bias=False, consider_radar_face=consider)
     fuser = Fuser(config)
     radar = make_track(1, "radar", 300.0, 0.0)
     radar.length_m = 12.0
@@ -430,7 +430,7 @@ def test_a_radar_track_left_on_its_face_reports_the_hidden_depth_in_its_covarian
     ais = make_track(2, "ais", 300.0, 0.0, mmsi=257000001)
     (with_ais,) = ship.step(0.0, {"radar": [radar], "ais": [ais]}, own)
     assert "ais" in with_ais.sources
-    plain = Fuser(FusionConfig(consider_radar_face=False)).step(0.0, {"radar": [radar], "ais": [ais]}, own)[0]
+    plain = Fuser(FusionConfig(consider_nav_bias=False, consider_radar_face=False)).step(0.0, {"radar": [radar], "ais": [ais]}, own)[0]
     assert with_ais.p == pytest.approx(plain.p)
 
 
@@ -439,7 +439,7 @@ def test_the_lidars_near_side_offset_is_reported_in_the_covariance_not_the_state
     """A LiDAR track (var 1 m^2, 10 m long, extent 0.3 of it: 9 m^2 of offset) and a radar track 4 m east (var
     4 m^2): the fused position is the same either way; the reported variance gains 9 x (0.8)^2 = 5.76 m^2 (the
     LiDAR's weight 4 / 5) with ``consider_lidar_extent``."""
-    fuser = Fuser(FusionConfig(consider_lidar_extent=consider))
+    fuser = Fuser(FusionConfig(consider_nav_bias=False, consider_lidar_extent=consider))
     lidar = make_track(1, "lidar", 0.0, 100.0, var=1.0)
     lidar.length_m, lidar.extent_sigma_fraction = 10.0, 0.3
     radar = make_track(2, "radar", 4.0, 100.0, var=4.0)

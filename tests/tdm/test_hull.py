@@ -50,7 +50,7 @@ def test_an_ais_ships_radar_track_weighs_with_where_on_the_hull_it_may_lie(weigh
     """An AIS ship (100 m x 16 m, north at 5 m/s, var 4 m^2) and its radar track 3 m ahead (var 4 m^2): without the
     hull the fused north is their mean, 1.5 m; with it the radar's north variance is 4 + 100^2 / 12 and its east
     4 + 16^2 / 12, so the fused position stays by the AIS; the covariance says so too."""
-    fuser = Fuser(FusionConfig(weigh_hull=weigh))
+    fuser = Fuser(FusionConfig(consider_nav_bias=False, weigh_hull=weigh))
     fuser.lengths_by_mmsi, fuser.beams_by_mmsi = {257000001: 100.0}, {257000001: 16.0}
     ais, radar = _track(1, "ais", 0.0, mmsi=257000001), _track(2, "radar", 3.0)
     (out,) = fuser.step(0.0, {"ais": [ais], "radar": [radar]})
@@ -68,7 +68,7 @@ def test_without_ais_dimensions_or_without_ais_the_radar_weighs_as_its_filter_sa
     for tracks, lengths in (({"ais": [_track(1, "ais", 0.0, mmsi=257000001)], "radar": [_track(2, "radar", 3.0)]}, {}),
                             ({"lidar": [_track(1, "lidar", 0.0)], "radar": [_track(2, "radar", 3.0)]},
                              {257000001: 100.0})):
-        fuser = Fuser(FusionConfig())
+        fuser = Fuser(FusionConfig(consider_nav_bias=False))
         fuser.lengths_by_mmsi = lengths
         (out,) = fuser.step(0.0, tracks)
         assert out.x[1] == pytest.approx(1.5)
@@ -80,7 +80,7 @@ def test_an_ais_ships_lidar_track_weighs_with_the_hull_less_the_part_it_sees():
     of what it sees, so its north variance is 4 + (100 - 60)^2 / 12; one seeing the whole hull gets the beam's
     variance across only."""
     for seen_m, north_extra in ((60.0, 40.0 ** 2 / 12.0), (120.0, 0.0)):
-        fuser = Fuser(FusionConfig())
+        fuser = Fuser(FusionConfig(consider_nav_bias=False))
         fuser.lengths_by_mmsi, fuser.beams_by_mmsi = {257000001: 100.0}, {257000001: 16.0}
         ais, lidar = _track(1, "ais", 0.0, mmsi=257000001), _track(2, "lidar", 3.0)
         lidar.length_m = seen_m

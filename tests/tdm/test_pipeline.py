@@ -229,13 +229,15 @@ def test_radar_tracks_report_their_face_offset_along_the_line_of_sight_from_the_
     each radar track's covariance differs by a u^T (the face offset along the line of sight u from the own ship at
     that epoch) minus b I (the 0.5 x length per axis it replaces), so the difference's larger eigenvector points
     along u and its other eigenvalue is not positive."""
+    from dataclasses import replace
+
     from groundfloor.frames import LocalFrame
-    from tdm.fusion import FusionConfig
     from tdm.pipeline import run_tdm
     from tdm.run_config import TdmConfig
 
     rec, _ = busy
-    off = TdmConfig.for_recording(rec, fusion_config=FusionConfig(radar_track_face_covariance=False))
+    on = TdmConfig.for_recording(rec)
+    off = replace(on, fusion_config=replace(on.fusion_config, radar_track_face_covariance=False))
     run_tdm(rec, tmp_path / "off", off)
 
     def radar_rows(path: Path) -> dict:
