@@ -134,8 +134,9 @@ class Fuser:
 
         ``own_position_m`` (2,), the own ship's east and north at ``t_s`` (m), lets still targets' radar tracks
         be put behind their painted face (``radar_hidden_depth_fraction``) and the other radar tracks' face offset be
-        reported along the line of sight (``consider_radar_face``); None or not finite: as they are, and no face
-        offset.
+        reported along the line of sight (``consider_radar_face``), and the heading bias's share of the own ship's
+        navigation bias (``consider_nav_bias``); None or not finite: as they are, no face offset, and the position
+        bias alone.
         """
         self._memo = {}
         if own_position_m is not None:
@@ -312,7 +313,7 @@ class Fuser:
         return 0.5 * distance * math.radians(beam_deg)
 
     def _considered(self, target: FusedTarget, states: dict, live: dict, p: np.ndarray,
-                    own_position_m: np.ndarray | None, moved: set) -> np.ndarray:
+                    own_position_m: np.ndarray | None, moved: set[tuple[str, int]]) -> np.ndarray:
         """``p`` (6, 6), the target's fused covariance, with the biases of its members' positions taken through the
         fusion (:func:`tdm.fusion_rules.consider_covariance`): its LiDAR track's extent variance
         (``consider_lidar_extent``), its radar track's face offset (``consider_radar_face``,

@@ -6,10 +6,11 @@ object's centre lies behind it along the line of sight by about half the object'
 
 - **Still targets without AIS** (``radar_hidden_depth_*``): the radar track is moved its hidden depth behind the
   face, and the depth's variance is added along the line of sight (:func:`behind_the_face`).
-- **Other targets without AIS** (``consider_radar_face``): the track is left on the face (a ship under way, a
-  target not yet known to be still, or a track that joined a still target during the step), and the offset it carries, the hidden depth squared plus its variance along
-  the line of sight, is reported in the target's covariance as a consider term (:func:`face_covariance`;
-  :func:`tdm.fusion_rules.consider_covariance`), not fed to the fusion's weights or gates.
+- **Other targets without AIS** (``consider_radar_face``): the track is left on the face (a ship under way, a target
+  not yet known to be still, or a track that joined a still target during the step), and the offset it carries, the
+  hidden depth squared plus its variance along the line of sight, is reported in the target's covariance as a
+  consider term (:func:`face_covariance`; :func:`tdm.fusion_rules.consider_covariance`), not fed to the fusion's
+  weights or gates.
 - **The radar's own tracks** (``radar_track_face_covariance``): in ``sensor_tracks.jsonl`` each radar track reports
   the same face offset, along the line of sight, in place of a fraction of its length per axis
   (:func:`face_report`); it knows nothing of AIS or of being still, so every radar track does. A LiDAR or radar
@@ -93,7 +94,8 @@ def face_report(track: Track, t_s: float, own_m: np.ndarray | None, config: Fusi
                 ) -> tuple[np.ndarray, np.ndarray]:
     """What a radar track reports in ``sensor_tracks.jsonl`` at ``t_s`` (s): its predicted state (6,) and covariance
     (6, 6), with its face offset (:func:`sight_covariance`) added to the position's covariance where
-    ``radar_track_face_covariance`` is on and the own ship's position ``own_m`` (2,) (m) is known (not None, finite), else
+    ``radar_track_face_covariance`` is on and the own ship's position ``own_m`` (2,) (m) is known (not None,
+    finite), else
     :meth:`tdm.tracker.Track.reported` (``extent_sigma_fraction`` of its length per axis)."""
     if not config.radar_track_face_covariance or own_m is None or not np.all(np.isfinite(own_m)):
         return track.reported(t_s)

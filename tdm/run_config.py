@@ -81,10 +81,11 @@ class TdmConfig:
     def for_recording(cls, recording: Path, **changes) -> "TdmConfig":
         """The defaults with ``update_rate_hz`` and the own ship's navigation bias (``sensors.nav.position_bias_m``,
         ``heading_bias_deg``: :attr:`FusionConfig.nav_position_bias_m`) from the recording's scenario.yaml, then
-        ``changes``."""
+        ``changes``; a ``fusion_config`` given takes the recording's navigation bias too."""
         scenario = read_scenario(recording)
         rate = float((scenario.get("tdm") or {}).get("update_rate_hz", DEFAULT_UPDATE_RATE_HZ))
-        return cls(**{"update_rate_hz": rate, "fusion_config": _with_nav_bias(FusionConfig(), scenario), **changes})
+        fusion = _with_nav_bias(changes.pop("fusion_config", FusionConfig()), scenario)
+        return cls(**{"update_rate_hz": rate, "fusion_config": fusion, **changes})
 
 
 def _with_nav_bias(config: FusionConfig, scenario: dict) -> FusionConfig:

@@ -73,7 +73,8 @@ def test_a_still_targets_radar_track_is_put_its_hidden_depth_behind_the_face_alo
     (still,) = fuser.step(1.0, {"radar": [radar]}, own)
     depth = FusionConfig(consider_nav_bias=False).radar_hidden_depth_length_fraction * 12.0
     assert depth > 0.0 and still.x[:2] == pytest.approx([0.0, 500.0 + depth])
-    sigma = FusionConfig(consider_nav_bias=False).radar_hidden_depth_length_sigma_fraction * 12.0  # the depth's uncertainty, along the sight line
+    # the depth's uncertainty, along the sight line
+    sigma = FusionConfig(consider_nav_bias=False).radar_hidden_depth_length_sigma_fraction * 12.0
     predicted = radar.predicted(1.0)[1][:2, :2]
     assert still.p[:2, :2] == pytest.approx(predicted + np.diag([0.0, sigma**2]))
     assert radar.x[:2] == pytest.approx([0.0, 500.0])  # the track itself is untouched
@@ -430,7 +431,8 @@ def test_a_radar_track_left_on_its_face_reports_the_hidden_depth_in_its_covarian
     ais = make_track(2, "ais", 300.0, 0.0, mmsi=257000001)
     (with_ais,) = ship.step(0.0, {"radar": [radar], "ais": [ais]}, own)
     assert "ais" in with_ais.sources
-    plain = Fuser(FusionConfig(consider_nav_bias=False, consider_radar_face=False)).step(0.0, {"radar": [radar], "ais": [ais]}, own)[0]
+    plain = Fuser(FusionConfig(consider_nav_bias=False, consider_radar_face=False)).step(
+        0.0, {"radar": [radar], "ais": [ais]}, own)[0]
     assert with_ais.p == pytest.approx(plain.p)
 
 
@@ -588,68 +590,3 @@ def test_a_broken_ais_covariance_does_not_hold_a_far_member_for_ever():
     coast = np.diag([1e5, 1.0])  # sd 316 m east: within the gate and within 120 + 3 x 316 m
     assert not fuser._released(far, summed + coast, coast)
 
-
-def test_a_radar_track_that_joins_a_still_target_during_the_step_is_widened_not_left_bare():
-    """An iceberg seen by the LiDAR alone; a radar track 12 m long starts on it 300 m east and joins it in that step.
-    ``behind_the_face`` ran before it joined, so it stays on its face: its offset, depth^2 + sigma^2 along the line
-    of sight (east), is reported through its fusion weight (here 1/2: both tracks 4 m^2), and nothing across it.
-    The next step it is moved, and only the depth's variance is carried."""
-    config = FusionConfig(weigh_extent=False, consider_lidar_extent=False)
-    fuser = Fuser(config)
-    own = np.zeros(2)
-    lidar = make_track(1, "lidar", 300.0, 0.0)
-    (alone,) = fuser.step(0.0, {"lidar": [lidar]}, own)
-    alone.target.descriptor = "iceberg"
-    lidar = make_track(1, "lidar", 300.0, 0.0, t=1.0)  # updated at 1 s: both tracks 4 m^2 then
-    radar = make_track(2, "radar", 300.0, 0.0, t=1.0)
-    radar.length_m = 12.0
-    (joined,) = fuser.step(1.0, {"lidar": [lidar], "radar": [radar]}, own)
-    assert joined.sources == ["lidar", "radar"]
-    bare = Fuser(FusionConfig(weigh_extent=False, consider_lidar_extent=False, consider_radar_face=False))
-    (b,) = bare.step(0.0, {"lidar": [lidar]}, own)
-    b.target.descriptor = "iceberg"
-    (plain,) = bare.step(1.0, {"lidar": [lidar], "radar": [radar]}, own)
-    depth = config.radar_hidden_depth_length_fraction * 12.0
-    sigma = config.radar_hidden_depth_length_sigma_fraction * 12.0
-    added = joined.p[:2, :2] - plain.p[:2, :2]
-    assert added == pytest.approx(np.diag([0.25 * (depth ** 2 + sigma ** 2), 0.0]))
-
-
-def test_a_radar_track_moved_behind_its_face_is_not_widened_again_in_a_vessels_target():
-    """``face_covariance`` goes by what ``behind_the_face`` did, not by the target's class at the step's end: a track
-    moved (its depth's variance already in its state) adds nothing even in a vessel's target; one not moved adds
-    its offset even in an iceberg's; a target with AIS, or an unknown own position, adds nothing."""
-    from tdm.fusion import FusedTarget
-    from tdm.fusion_face import face_covariance, sight_covariance
-
-    config = FusionConfig()
-    radar = make_track(2, "radar", 300.0, 0.0)
-    radar.length_m = 12.0
-    own = np.zeros(2)
-    full = sight_covariance(radar, radar.x, own, config)
-    assert full[0, 0] > 0.0
-    for descriptor in ("vessel", "iceberg", "unknown"):
-        target = FusedTarget(1, created_s=0.0)
-        target.descriptor, target.members = descriptor, {"radar": 2}
-        assert np.all(face_covariance(target, True, radar.x, radar, own, config) == 0.0)
-        assert face_covariance(target, False, radar.x, radar, own, config) == pytest.approx(full)
-        assert np.all(face_covariance(target, False, radar.x, radar, None, config) == 0.0)
-        target.members["ais"] = 5
-        assert np.all(face_covariance(target, False, radar.x, radar, own, config) == 0.0)
-
-
-def test_an_own_position_that_is_not_finite_counts_as_unknown():
-    """A NaN own-ship position gives what None gives (``Fuser.step`` takes it for unknown): a second radar track 3 m
-    from a radar target is absorbed, by its footprint alone, and no offset is reported."""
-    config = FusionConfig()
-    first = make_track(1, "radar", 300.0, 0.0)
-    second = make_track(2, "radar", 303.0, 0.0, t=1.0)
-    for t in (first, second):
-        t.length_m = 12.0
-    out = {}
-    for name, own in (("nan", np.array([np.nan, 0.0])), ("none", None)):
-        fuser = Fuser(config)
-        fuser.step(0.0, {"radar": [first]}, own)
-        out[name] = fuser.step(1.0, {"radar": [first, second]}, own)
-    assert len(out["none"]) == len(out["nan"]) == 1
-    assert out["nan"][0].x == pytest.approx(out["none"][0].x) and out["nan"][0].p == pytest.approx(out["none"][0].p)

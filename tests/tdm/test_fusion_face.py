@@ -3,9 +3,11 @@
 import numpy as np
 import pytest
 
-from tdm.fusion import FusionConfig
+from tdm.fusion import Fuser, FusionConfig
 from tdm.fusion_face import face_report, hidden_depth_m, sight_covariance
 from tdm.tracker import Track
+
+from .test_fusion import make_track
 
 
 def radar_track(east_m: float, north_m: float, length_m: float = 12.0, core_width_m: float = float("nan")) -> Track:
@@ -56,3 +58,70 @@ def test_a_radar_track_with_an_own_position_not_finite_reports_as_without_one():
     track = radar_track(500.0, 0.0, core_width_m=55.0)
     x, p = face_report(track, 2.0, np.array([np.nan, 0.0]), config)
     assert p == pytest.approx(track.reported(2.0)[1]) and x == pytest.approx(track.reported(2.0)[0])
+
+
+def test_a_radar_track_that_joins_a_still_target_during_the_step_is_widened_not_left_bare():
+    """An iceberg seen by the LiDAR alone; a radar track 12 m long starts on it 300 m east and joins it in that step.
+    ``behind_the_face`` ran before it joined, so it stays on its face: its offset, depth^2 + sigma^2 along the line
+    of sight (east), is reported through its fusion weight (here 1/2: both tracks 4 m^2), and nothing across it.
+    The next step it is moved, and only the depth's variance is carried."""
+    config = FusionConfig(weigh_extent=False, consider_lidar_extent=False)
+    fuser = Fuser(config)
+    own = np.zeros(2)
+    lidar = make_track(1, "lidar", 300.0, 0.0)
+    (alone,) = fuser.step(0.0, {"lidar": [lidar]}, own)
+    alone.target.descriptor = "iceberg"
+    lidar = make_track(1, "lidar", 300.0, 0.0, t=1.0)  # updated at 1 s: both tracks 4 m^2 then
+    radar = make_track(2, "radar", 300.0, 0.0, t=1.0)
+    radar.length_m = 12.0
+    (joined,) = fuser.step(1.0, {"lidar": [lidar], "radar": [radar]}, own)
+    assert joined.sources == ["lidar", "radar"]
+    bare = Fuser(FusionConfig(weigh_extent=False, consider_lidar_extent=False, consider_radar_face=False))
+    (b,) = bare.step(0.0, {"lidar": [lidar]}, own)
+    b.target.descriptor = "iceberg"
+    (plain,) = bare.step(1.0, {"lidar": [lidar], "radar": [radar]}, own)
+    depth = config.radar_hidden_depth_length_fraction * 12.0
+    sigma = config.radar_hidden_depth_length_sigma_fraction * 12.0
+    added = joined.p[:2, :2] - plain.p[:2, :2]
+    assert added == pytest.approx(np.diag([0.25 * (depth ** 2 + sigma ** 2), 0.0]))
+
+
+def test_a_radar_track_moved_behind_its_face_is_not_widened_again_in_a_vessels_target():
+    """``face_covariance`` goes by what ``behind_the_face`` did, not by the target's class at the step's end: a track
+    moved (its depth's variance already in its state) adds nothing even in a vessel's target; one not moved adds
+    its offset even in an iceberg's; a target with AIS, or an unknown own position, adds nothing."""
+    from tdm.fusion import FusedTarget
+    from tdm.fusion_face import face_covariance, sight_covariance
+
+    config = FusionConfig()
+    radar = make_track(2, "radar", 300.0, 0.0)
+    radar.length_m = 12.0
+    own = np.zeros(2)
+    full = sight_covariance(radar, radar.x, own, config)
+    assert full[0, 0] > 0.0
+    for descriptor in ("vessel", "iceberg", "unknown"):
+        target = FusedTarget(1, created_s=0.0)
+        target.descriptor, target.members = descriptor, {"radar": 2}
+        assert np.all(face_covariance(target, True, radar.x, radar, own, config) == 0.0)
+        assert face_covariance(target, False, radar.x, radar, own, config) == pytest.approx(full)
+        assert np.all(face_covariance(target, False, radar.x, radar, None, config) == 0.0)
+        target.members["ais"] = 5
+        assert np.all(face_covariance(target, False, radar.x, radar, own, config) == 0.0)
+
+
+def test_an_own_position_that_is_not_finite_counts_as_unknown():
+    """A NaN own-ship position gives what None gives (``Fuser.step`` takes it for unknown): a second radar track 3 m
+    from a radar target is absorbed, by its footprint alone, and no offset is reported. A guard: before 01ca88e
+    this held by accident (a NaN resolution lost in ``max`` and in the merge), not by design."""
+    config = FusionConfig()
+    first = make_track(1, "radar", 300.0, 0.0)
+    second = make_track(2, "radar", 303.0, 0.0, t=1.0)
+    for t in (first, second):
+        t.length_m = 12.0
+    out = {}
+    for name, own in (("nan", np.array([np.nan, 0.0])), ("none", None)):
+        fuser = Fuser(config)
+        fuser.step(0.0, {"radar": [first]}, own)
+        out[name] = fuser.step(1.0, {"radar": [first, second]}, own)
+    assert len(out["none"]) == len(out["nan"]) == 1
+    assert out["nan"][0].x == pytest.approx(out["none"][0].x) and out["nan"][0].p == pytest.approx(out["none"][0].p)

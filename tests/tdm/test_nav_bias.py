@@ -65,11 +65,14 @@ def test_targets_and_sensor_tracks_measured_from_the_own_ship_carry_its_navigati
 
 
 def test_the_bias_is_the_recordings_and_a_bad_value_is_refused(tmp_path):
-    """TdmConfig.for_recording takes sensors.nav.position_bias_m and heading_bias_deg from scenario.yaml."""
+    """TdmConfig.for_recording takes sensors.nav.position_bias_m and heading_bias_deg from scenario.yaml, also into a
+    fusion_config it is given."""
     (tmp_path / "scenario.yaml").write_text(yaml.safe_dump(
         {"sensors": {"nav": {"position_bias_m": 2.0, "heading_bias_deg": 0.5}}}))
     fusion = TdmConfig.for_recording(tmp_path).fusion_config
     assert (fusion.nav_position_bias_m, fusion.nav_heading_bias_deg) == (2.0, 0.5)
+    given = TdmConfig.for_recording(tmp_path, fusion_config=FusionConfig(consider_radar_face=False)).fusion_config
+    assert (given.nav_position_bias_m, given.consider_radar_face) == (2.0, False)
     (tmp_path / "scenario.yaml").write_text(yaml.safe_dump({"sensors": {"nav": {"enabled": False}}}))
     assert TdmConfig.for_recording(tmp_path).fusion_config.nav_position_bias_m == FusionConfig().nav_position_bias_m
     (tmp_path / "scenario.yaml").write_text(yaml.safe_dump({"sensors": {"nav": {"position_bias_m": -1.0}}}))

@@ -244,7 +244,8 @@ def test_radar_tracks_report_their_face_offset_along_the_line_of_sight_from_the_
         rows = (json.loads(line) for line in path.read_text().splitlines())
         return {(r["t"], r["target_id"]): r for r in rows if r["sensor"] == "radar"}
 
-    on_rows, off_rows = radar_rows(rec / "tdm" / "sensor_tracks.jsonl"), radar_rows(tmp_path / "off" / "sensor_tracks.jsonl")
+    on_rows = radar_rows(rec / "tdm" / "sensor_tracks.jsonl")
+    off_rows = radar_rows(tmp_path / "off" / "sensor_tracks.jsonl")
     assert on_rows.keys() == off_rows.keys() and len(on_rows) > 20
     own = [json.loads(line) for line in (rec / "ownship.jsonl").read_text().splitlines()]
     own_t = np.array([o["t"] for o in own])
