@@ -60,9 +60,9 @@ from tdm.fusion_geometry import clearly_apart as _clearly_apart
 from tdm.fusion_geometry import inside_reference as _inside_reference
 from tdm.fusion_geometry import major_variance as _major_variance
 from tdm.fusion_geometry import moves_apart as _moves_apart
-from tdm.fusion_face import STILL_DESCRIPTORS, behind_the_face, face_covariance
-from tdm.fusion_rules import consider_covariance, fuse
-from tdm.nav_bias import NAV_RELATIVE_SENSORS, nav_bias_covariance
+from tdm.fusion_consider import reported_covariance
+from tdm.fusion_face import STILL_DESCRIPTORS, behind_the_face
+from tdm.fusion_rules import fuse
 from tdm.fusion_weights import member_hull_covariance, with_extent, with_fragments, with_hull
 from tdm.tracker import Track, predicted_at
 
@@ -211,7 +211,7 @@ class Fuser:
             weigh = with_fragments(weigh, self.targets, cfg.fragment_sensors)
         for target in self.targets:
             x, p = self._estimate(target, weigh)
-            reported_p = self._considered(target, weigh, live, p, own_position_m, moved)
+            reported_p = reported_covariance(target, x, p, weigh, live, own_position_m, moved, cfg)
             target.last_x, target.last_t_s, target.radius_m = x, t_s, self._half_length(target, live)
             ais_track = live.get(("ais", target.members.get("ais", -1)))
             target.mmsi = ais_track.mmsi if ais_track is not None else target.mmsi
@@ -311,33 +311,6 @@ class Fuser:
             return 0.0
         distance = math.hypot(float(x[0]) - float(own_position_m[0]), float(x[1]) - float(own_position_m[1]))
         return 0.5 * distance * math.radians(beam_deg)
-
-    def _considered(self, target: FusedTarget, states: dict, live: dict, p: np.ndarray,
-                    own_position_m: np.ndarray | None, moved: set[tuple[str, int]]) -> np.ndarray:
-        """``p`` (6, 6), the target's fused covariance, with the biases of its members' positions taken through the
-        fusion (:func:`tdm.fusion_rules.consider_covariance`): its LiDAR track's extent variance
-        (``consider_lidar_extent``), its radar track's face offset (``consider_radar_face``,
-        :func:`tdm.fusion_face.face_covariance`) unless the track is one of ``moved``, those
-        :func:`tdm.fusion_face.behind_the_face` put behind their face this step, and the own ship's navigation bias
-        that its LiDAR and radar tracks share (``consider_nav_bias``, :mod:`tdm.nav_bias`)."""
-        cfg = self.config
-        keys = list(target.members.items())
-        v = np.zeros((len(keys), 2, 2))
-        for n, key in enumerate(keys):
-            if key[0] == "lidar" and cfg.consider_lidar_extent:
-                v[n] = live[key].extent_var_m2 * np.eye(2)
-            elif key[0] == "radar" and cfg.consider_radar_face:
-                v[n] = face_covariance(target, key in moved, states[key][0], live[key], own_position_m, cfg)
-        shared = np.array([key[0] in NAV_RELATIVE_SENSORS for key in keys])
-        nav = None
-        if cfg.consider_nav_bias and shared.any():
-            x, _ = self._estimate(target, states)
-            nav = nav_bias_covariance(x[:2], own_position_m, cfg.nav_position_bias_m, cfg.nav_heading_bias_deg)
-        if not np.any(v > 0.0) and (nav is None or not np.any(nav > 0.0)):
-            return p
-        xs = np.array([states[k][0] for k in keys])
-        ps = np.array([states[k][1] for k in keys])
-        return p + consider_covariance(xs, ps, v, cfg.rule, nav, shared)
 
     def _estimate(self, target: FusedTarget, states) -> tuple[np.ndarray, np.ndarray]:
         """The target's fused state (6,) and covariance (6, 6) from its members' ``states``.

@@ -1,0 +1,73 @@
+"""The covariance a fused target reports: its fusion's, with the biases its members' positions carry taken through
+the fusion's weights (:class:`tdm.fusion.Fuser`; :func:`tdm.fusion_rules.consider_covariance`).
+
+Three biases, each a "consider" term (as in the Schmidt-Kalman filter: a slowly changing offset, not noise, kept out
+of the fusion's weights and gates and reported):
+
+- a LiDAR track's centre behind the side it sees (``consider_lidar_extent``; :attr:`tdm.tracker.Track.extent_var_m2`
+  per axis);
+- a radar track left on the face it paints (``consider_radar_face``; :func:`tdm.fusion_face.face_covariance`);
+- the own ship's navigation bias, one bias shared by every LiDAR and radar member (``consider_nav_bias``;
+  :mod:`tdm.nav_bias`).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from tdm.fusion_config import FusionConfig
+from tdm.fusion_face import face_covariance
+from tdm.fusion_rules import consider_covariance
+from tdm.nav_bias import NAV_RELATIVE_SENSORS, nav_bias_covariance
+
+if TYPE_CHECKING:  # pragma: no cover
+    from tdm.fusion import FusedTarget
+
+__all__ = ["reported_covariance"]
+
+
+def reported_covariance(target: FusedTarget, x: np.ndarray, p: np.ndarray, states: dict, live: dict,
+                        own_m: np.ndarray | None, moved: set[tuple[str, int]], config: FusionConfig) -> np.ndarray:
+    """The target's fused covariance with its members' biases considered.
+
+    Parameters
+    ----------
+    target : FusedTarget
+        Its members at the end of the step.
+    x : (6,) float
+        The target's fused state (position east, north, m).
+    p : (6, 6) float
+        Its fused covariance.
+    states : dict
+        ``(sensor, track id) -> (x (6,), p (6, 6))``: the members' states as the fusion weighed them.
+    live : dict
+        ``(sensor, track id) -> Track``.
+    own_m : (2,) float or None
+        Own ship's east and north, m; None: unknown (no face offset, the navigation's position bias alone).
+    moved : set of (str, int)
+        The radar tracks :func:`tdm.fusion_face.behind_the_face` moved this step (their depth is in their state).
+    config : FusionConfig
+
+    Returns
+    -------
+    (6, 6) float
+        ``p`` plus the considered terms; ``p`` itself where there are none.
+    """
+    keys = list(target.members.items())
+    v = np.zeros((len(keys), 2, 2))
+    for n, key in enumerate(keys):
+        if key[0] == "lidar" and config.consider_lidar_extent:
+            v[n] = live[key].extent_var_m2 * np.eye(2)
+        elif key[0] == "radar" and config.consider_radar_face:
+            v[n] = face_covariance(target, key in moved, states[key][0], live[key], own_m, config)
+    shared = np.array([key[0] in NAV_RELATIVE_SENSORS for key in keys])
+    nav = None
+    if config.consider_nav_bias and shared.any():
+        nav = nav_bias_covariance(x[:2], own_m, config.nav_position_bias_m, config.nav_heading_bias_deg)
+    if not np.any(v > 0.0) and (nav is None or not np.any(nav > 0.0)):
+        return p
+    xs = np.array([states[k][0] for k in keys])
+    ps = np.array([states[k][1] for k in keys])
+    return p + consider_covariance(xs, ps, v, config.rule, nav, shared)
