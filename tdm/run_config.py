@@ -11,6 +11,7 @@ from pathlib import Path
 
 from tdm.fusion import FusionConfig
 from tdm.io import read_scenario
+from tdm.recording.scenario import nav_settings
 from tdm.ais_tracker import AisTrackerConfig
 from tdm.tracker import TrackerConfig
 
@@ -91,9 +92,7 @@ class TdmConfig:
 def _with_nav_bias(config: FusionConfig, scenario: dict) -> FusionConfig:
     """``config`` with the navigation bias the scenario states (``sensors.nav``; checked by
     :func:`tdm.io.read_scenario`); a disabled or absent nav keeps the defaults."""
-    nav = (scenario.get("sensors") or {}).get("nav") or {}
-    if not nav.get("enabled", True):
-        return config
+    nav = nav_settings(scenario)
     values = {field_name: float(nav[key]) for field_name, key in (("nav_position_bias_m", "position_bias_m"),
                                                                   ("nav_heading_bias_deg", "heading_bias_deg"))
               if nav.get(key) is not None}

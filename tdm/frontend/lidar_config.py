@@ -11,6 +11,7 @@ from typing import Literal
 
 from groundfloor.recording import LidarDescription
 from tdm.frames import Mount
+from tdm.recording.scenario import nav_settings
 
 __all__ = ["HDL32E_FIRING_CYCLE_S", "LINK_WINDOW_CYCLES", "LidarFrontEndConfig", "lidar_mount_from_scenario"]
 
@@ -193,11 +194,11 @@ class LidarFrontEndConfig:
         for name in ("range_min_m", "range_max_m", "rotation_hz", "beam_divergence_mrad"):
             if getattr(lidar, name) is not None:
                 values[name] = getattr(lidar, name)
-        nav = (scenario.get("sensors") or {}).get("nav") or {}
-        if nav.get("enabled", True) and any(k in nav for k in ("position_noise_m", "position_bias_m")):
+        nav = nav_settings(scenario)
+        if any(k in nav for k in ("position_noise_m", "position_bias_m")):
             values["nav_position_sigma_m"] = math.hypot(float(nav.get("position_noise_m", 0.0)),
                                                         float(nav.get("position_bias_m", 0.0)))
-        if nav.get("enabled", True) and any(k in nav for k in ("heading_noise_deg", "heading_bias_deg")):
+        if any(k in nav for k in ("heading_noise_deg", "heading_bias_deg")):
             values["nav_heading_sigma_deg"] = math.hypot(float(nav.get("heading_noise_deg", 0.0)),
                                                          float(nav.get("heading_bias_deg", 0.0)))
         values.update(overrides)

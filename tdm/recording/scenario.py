@@ -20,7 +20,7 @@ from tdm.errors import RecordingError
 from tdm.recording import values
 from tdm.recording.files import decode_utf8, read_bytes
 
-__all__ = ["read_scenario", "check_scenario", "CHECKED", "MAX_UPDATE_RATE_HZ"]
+__all__ = ["read_scenario", "check_scenario", "nav_settings", "CHECKED", "MAX_UPDATE_RATE_HZ"]
 
 #: Highest accepted TDM output rate, Hz (raysim's scenarios allow 50).
 MAX_UPDATE_RATE_HZ = 100.0
@@ -119,3 +119,10 @@ def read_scenario(recording: Path) -> dict:
     except RecursionError:
         raise RecordingError(str(path), "(file)", "not valid YAML: nested too deeply") from None
     return check_scenario(data, path)
+
+
+def nav_settings(scenario: dict) -> dict:
+    """The own ship's navigation section of a checked scenario (``sensors.nav``: its noise and bias figures), or an
+    empty mapping where it is absent or disabled (``enabled: false``)."""
+    nav = (scenario.get("sensors") or {}).get("nav") or {}
+    return nav if nav.get("enabled", True) else {}
