@@ -4,7 +4,7 @@ Usage::
 
     python benchmarks/tdm_heldout.py [--seeds 31-35] [--duration 300] [--scenarios NAME,...] [--work DIR]
                                      [--keep-seeds 31] [--rerun] [--out benchmarks/results/tdm_heldout.md]
-                                     [--json FILE]
+                                     [--json benchmarks/results/tdm_heldout.json]
 
 The TDM's configuration is tuned on ``busy_open_sea`` only; the other scenarios are held out. For each
 scenario and seed (seed-major, so that a stopped run has every scenario for its first seeds): ``raysim
@@ -14,7 +14,9 @@ configuration; the run's metrics.json is kept in ``WORK/metrics/``, the sensors'
 unless the seed is one of ``--keep-seeds`` (a 300 s recording is about 2 GB); a run whose metrics are there
 is not done again and a kept recording is not rendered again (a stopped benchmark goes on where it
 stopped). ``--rerun``: run the TDM and evaluate
-again on the kept recordings (after a TDM change) and report those runs only.
+again on the kept recordings (after a TDM change) and report those runs only. ``--json``: every run's
+criteria (``{"generated", "seeds", "duration_s", "runs"}``), which benchmarks/tdm_criteria.py tabulates run by
+run into benchmarks/results/tdm_criteria.md.
 
 The criteria (issue 22, "Done when"), per run:
 
@@ -100,6 +102,7 @@ def run_criteria(metrics: dict, closest: dict[str, float]) -> dict:
         "median_error_within_lidar_m": metrics["median_position_error_within_lidar_range_m"],
         "median_error_beyond_lidar_m": metrics["median_position_error_beyond_lidar_range_m"],
         "id_switches_max": metrics["id_switches_max_per_object"],
+        "id_switches_by_object": {o["name"]: o["id_switches"] for o in metrics["per_object"] if o["id_switches"]},
         "false_targets_per_min": metrics["false_targets_per_min"],
         "nees_fraction_in_95": metrics["nees_fraction_in_95"],
         "gospa_m": metrics.get("gospa_m"),
@@ -249,7 +252,8 @@ def main(argv=None) -> int:
     parser.add_argument("--keep-seeds", default="31", help="seeds whose recordings are kept for --rerun")
     parser.add_argument("--rerun", action="store_true", help="TDM and evaluation again on the kept recordings")
     parser.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results" / "tdm_heldout.md")
-    parser.add_argument("--json", type=Path)
+    parser.add_argument("--json", type=Path, default=ROOT / "benchmarks" / "results" / "tdm_heldout.json",
+                        help="the runs' criteria as JSON (benchmarks/tdm_criteria.py tabulates them)")
     args = parser.parse_args(argv)
     seeds, scenarios, keep = _seeds(args.seeds), args.scenarios.split(","), set(_seeds(args.keep_seeds))
     runs = []
@@ -263,8 +267,8 @@ def main(argv=None) -> int:
     text = report(runs, scenarios, seeds, args.duration)
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(text, encoding="utf-8")
-    if args.json:
-        args.json.write_text(json.dumps(runs, indent=1) + "\n", encoding="utf-8")
+    args.json.write_text(json.dumps({"generated": machine_line("tdm_heldout", False), "seeds": seeds,
+                                     "duration_s": args.duration, "runs": runs}, indent=1) + "\n", encoding="utf-8")
     print(text)
     return 0
 

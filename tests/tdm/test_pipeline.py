@@ -47,7 +47,7 @@ def busy(bos_recording, tmp_path_factory) -> tuple[Path, dict]:
 
 
 #: The radar of issue 19 (sidelobes, coherent echoes, wind-direction clutter) broke these criteria of the unchanged
-#: TDM; benchmarks/results/tdm_criteria.md says why, and the TDM issue (22) takes them on. Each is still checked,
+#: TDM; benchmarks/results/tdm_criteria_history.md says why, and the TDM issue (22) takes them on. Each is still checked,
 #: as a strict expected failure: when the TDM meets it again, the test fails until the mark is removed.
 ISSUE_19_FAILS = pytest.mark.xfail(strict=True, reason="radar of issue 19: upwind sea spikes confirm as radar-only "
                                    "false targets; coherent glints and mirror-like hulls move radar plots and sizes")
