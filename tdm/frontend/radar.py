@@ -487,8 +487,8 @@ def radar_detections(sweep: dict, track: OwnshipTrack, mount: Mount, config: Rad
         - ``beam_fill = extent_az / max(s_az, d_az)``: a point echo paints at least the beam's
           ``s_az``, so a plot with a fill well under 1 is narrower than anything received through
           the antenna can be (a sea spike; busy_open_sea, sea state 4: of the plots from 15 dB over
-          their background, clutter's have a median fill of 0.17 and 86 % are under 0.5, objects'
-          a median of 1.1 and 1 % under 0.5, benchmarks/results/tdm_criteria.md);
+          their background, clutter's have a median fill of 0.16 and 70 % are under 0.5, objects'
+          a median of 1.04 and 1 % under 0.5, benchmarks/results/tdm_criteria.md);
         - ``core_width_m = r sqrt(core_az^2 - (theta3 sqrt(c / 6.02))^2)`` (radians, 0 if negative): the width
           of the cells within ``c = core_db`` of the strongest, less the two-way beam's width ``c`` dB down, in
           quadrature; the size of an object the beam does not resolve, which ``Lc`` (taken down to the plot's
