@@ -55,6 +55,10 @@ class Detections:
         For a radar plot, the cross-range width of its core (cells within ``core_db`` of its strongest) less
         the beam's, m (:func:`tdm.frontend.radar.radar_detections`): the size of an object the beam smears.
         None for LiDAR.
+    range_cut : (N,) bool or None
+        For a LiDAR cluster, whether its farthest point lies at the sensor's range limit (within
+        :attr:`~tdm.frontend.lidar_config.LidarFrontEndConfig.range_cut_margin_m`): its object may go on beyond the
+        limit, unseen, and its centre lie metres deeper than the cluster shows. None for radar.
     """
 
     sensor: str
@@ -72,6 +76,7 @@ class Detections:
     strength_db: np.ndarray | None = None
     beam_fill: np.ndarray | None = None
     core_width_m: np.ndarray | None = None
+    range_cut: np.ndarray | None = None
 
     def __len__(self) -> int:
         return int(self.time_s.shape[0])

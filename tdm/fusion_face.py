@@ -115,7 +115,23 @@ def sensor_report(sensor: str, track: Track, t_s: float, own_m: np.ndarray | Non
     if config.consider_nav_bias and sensor in NAV_RELATIVE_SENSORS:
         p = p.copy()
         p[:2, :2] += nav_bias_covariance(x[:2], own_m, config.nav_position_bias_m, config.nav_heading_bias_deg)
+    if track.range_cut and track.range_cut_sigma_m > 0.0:
+        p = p.copy()
+        p[:2, :2] += range_cut_covariance(x[:2], own_m, track.range_cut_sigma_m)
     return x, p
+
+
+def range_cut_covariance(position_m: np.ndarray, own_m: np.ndarray | None, sigma_m: float) -> np.ndarray:
+    """(2, 2) covariance, m^2: ``sigma_m`` along the line of sight from ``own_m`` (2,) to ``position_m`` (2,), m, for
+    a track whose object may go on beyond the sensor's range limit (:attr:`tdm.tracker.TrackerConfig.range_cut_sigma_m`);
+    ``sigma_m`` per axis where the own ship is unknown (None or not finite) or on the track."""
+    if own_m is not None and np.all(np.isfinite(own_m)):
+        sight = np.asarray(position_m, dtype=float) - np.asarray(own_m, dtype=float)[:2]
+        distance = float(np.hypot(*sight))
+        if distance > 0.0:
+            u = sight / distance
+            return sigma_m ** 2 * np.outer(u, u)
+    return sigma_m ** 2 * np.eye(2)
 
 
 def sight_covariance(track: Track, x: np.ndarray, own_m: np.ndarray, config: FusionConfig) -> np.ndarray:

@@ -132,6 +132,11 @@ class TrackerConfig:
         fusion it widened the track-to-track gates and absorbing radii and made the fused targets worse
         (busy_open_sea, seed 7, 300 s, radar 0.5: median error within LiDAR range 2.55 -> 3.52 m, COG
         RMSE 5.7 -> 10.2 deg; docs/tdm.md). 0: none.
+    range_cut_sigma_m : float
+        A track last updated by a detection at the sensor's range limit (:attr:`~tdm.detections.Detections.range_cut`:
+        a LiDAR cluster of an object that may go on beyond it) reports this standard deviation more along the line
+        of sight from the own ship, m (:func:`tdm.fusion_face.sensor_report`; a consider term as the extent's, not
+        in the filter). 0: none.
     process : ekf.ProcessNoise
     """
 
@@ -156,6 +161,7 @@ class TrackerConfig:
     clutter_plots_per_scan: float = 0.1
     max_speed_mps: float = 20.0
     extent_sigma_fraction: float = 0.0
+    range_cut_sigma_m: float = 0.0
     process: ekf.ProcessNoise = field(default_factory=ekf.ProcessNoise)
 
 
@@ -204,6 +210,8 @@ class Track:
     core_width_m: float = float("nan")
     process: ekf.ProcessNoise = field(default_factory=ekf.ProcessNoise)
     extent_sigma_fraction: float = 0.0
+    range_cut: bool = False
+    range_cut_sigma_m: float = 0.0
     _last_prediction: tuple | None = field(default=None, init=False, repr=False, compare=False)
 
     def predicted(self, t_s: float) -> tuple[np.ndarray, np.ndarray]:
@@ -359,6 +367,7 @@ class PositionTracker:
         track.x, track.p, _ = ekf.update(x, p, z, ekf.H_POSITION_SIZE, r)
         track.t_s = track.updated_s = t
         track.n_updates += 1
+        track.range_cut = dets.range_cut is not None and bool(dets.range_cut[j])
         track.length_m = _smoothed_size(track.length_m, float(dets.length_m[j]), track.n_updates)
         if dets.core_width_m is not None:
             core_m = float(dets.core_width_m[j])
@@ -414,7 +423,8 @@ class PositionTracker:
                       first_position_m=dets.position_m[j].copy(), first_cov_m2=cov_j.copy(),
                       height_m=float(dets.height_m[j]), length_m=float(dets.length_m[j]), process=cfg.process,
                       core_width_m=float(dets.core_width_m[j]) if dets.core_width_m is not None else float("nan"),
-                      extent_sigma_fraction=cfg.extent_sigma_fraction)
+                      extent_sigma_fraction=cfg.extent_sigma_fraction, range_cut_sigma_m=cfg.range_cut_sigma_m,
+                      range_cut=dets.range_cut is not None and bool(dets.range_cut[j]))
         self._record(track, self._hit_weight(dets, j))
         self.tracks.append(track)
 

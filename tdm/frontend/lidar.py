@@ -85,6 +85,12 @@ Position covariance (ENU, m^2), a sum of independent terms:
 
 ``s_r > 0`` keeps P positive definite for any cluster, even a single point.
 
+Range cut: a cluster whose farthest point lies within ``range_cut_margin_m`` of ``range_max_m`` is flagged
+(``Detections.range_cut``): the sensor returns nothing beyond its range limit, so the object may go on there and
+its centre lie metres deeper than any of the above says. The position and covariance are left as they are (the
+offset is a bias shared by the scans of the object while it stays at the limit, which the filter would average
+away); the tracker reports it as a consider term (``TrackerConfig.range_cut_sigma_m``).
+
 The settings are :class:`LidarFrontEndConfig` (:mod:`tdm.frontend.lidar_config`), importable from here too.
 """
 
@@ -230,21 +236,23 @@ def lidar_clusters_batch(sweeps: list[dict[str, np.ndarray]], track: OwnshipTrac
         return [_nothing(s) for s in scan_time_s]
     member = good[label]
     label = (np.cumsum(good) - 1)[label[member]]
-    enu, t, idx, sweep = enu[member], t[member], idx[member], sweep[member]
+    enu, t, idx, sweep, range_m = enu[member], t[member], idx[member], sweep[member], range_m[member]
     n_cells = counts[good].astype(np.int64)
     cluster_sweep = np.zeros(n_cells.shape[0], dtype=np.int64)
     cluster_sweep[label] = sweep
-    detections = _cluster_detections(enu, t, label, n_cells, scan_time_s[cluster_sweep], track, mount, config)
+    detections = _cluster_detections(enu, t, label, n_cells, scan_time_s[cluster_sweep], track, mount, config,
+                                     range_m)
     point_start = np.cumsum(n_points) - n_points
     return _per_sweep(detections, scan_time_s, cluster_sweep, idx - point_start[sweep], label, sweep)
 
 
 def _cluster_detections(enu: np.ndarray, t: np.ndarray, label: np.ndarray, n_cells: np.ndarray,
                         scan_time_s: np.ndarray, track: OwnshipTrack, mount: Mount,
-                        config: LidarFrontEndConfig) -> dict[str, np.ndarray]:
+                        config: LidarFrontEndConfig, range_m: np.ndarray) -> dict[str, np.ndarray]:
     """Step 7: the (k,) per-cluster fields of :class:`Detections` of the member points (``label`` (M,),
-    ``n_cells`` (k,) points a cluster, ``scan_time_s`` (k,) of each cluster's sweep)."""
-    fp = _footprints(enu, t, label, n_cells)
+    ``n_cells`` (k,) points a cluster, ``scan_time_s`` (k,) of each cluster's sweep, ``range_m`` (M,) each
+    point's range from the sensor, m)."""
+    fp = _footprints(enu, t, label, n_cells, range_m)
     sensor_enu = track.sensor_to_enu(np.zeros((n_cells.shape[0], 3)), fp.mean_t if config.deskew else scan_time_s,
                                      mount)
     if config.centre == "outline":
@@ -260,7 +268,7 @@ def _cluster_detections(enu: np.ndarray, t: np.ndarray, label: np.ndarray, n_cel
                 position_cov_m2=_cluster_cov(fp, los_e, los_n, horizontal_range_m, config),
                 cross_section_m2=fp.length_m * fp.width_m, length_m=fp.length_m, width_m=fp.width_m,
                 orientation_deg=np.mod(90.0 - np.degrees(fp.phi_long), 180.0), height_m=fp.height_m,
-                n_cells=n_cells, range_m=horizontal_range_m)
+                n_cells=n_cells, range_m=horizontal_range_m, range_cut=_range_cut(fp, config))
 
 
 def _per_sweep(fields: dict[str, np.ndarray], scan_time_s: np.ndarray, cluster_sweep: np.ndarray,
@@ -349,7 +357,8 @@ def _kept_clusters(label: np.ndarray, on_surface: np.ndarray, config: LidarFront
 @dataclass
 class _Footprint:
     """Per cluster (k,): mean point (m), mean time (s), height (m), footprint box (m) and the ENU angle
-    of its long side (rad); each cluster's first position in the points sorted by cluster."""
+    of its long side (rad); each cluster's first position in the points sorted by cluster; the range of its
+    farthest point from the sensor (m)."""
 
     mean_e: np.ndarray
     mean_n: np.ndarray
@@ -359,10 +368,13 @@ class _Footprint:
     width_m: np.ndarray
     phi_long: np.ndarray
     starts: np.ndarray
+    farthest_m: np.ndarray
 
 
-def _footprints(enu: np.ndarray, t: np.ndarray, label: np.ndarray, n_cells: np.ndarray) -> _Footprint:
-    """Mean, height and PCA footprint box of every cluster (step 7), vectorised over clusters."""
+def _footprints(enu: np.ndarray, t: np.ndarray, label: np.ndarray, n_cells: np.ndarray,
+                range_m: np.ndarray) -> _Footprint:
+    """Mean, height, PCA footprint box and farthest point's range (``range_m`` (M,), m) of every cluster (step 7),
+    vectorised over clusters."""
     k = n_cells.shape[0]
     order = np.argsort(label, kind="stable")
     starts = np.concatenate([[0], np.cumsum(n_cells)[:-1]])
@@ -385,7 +397,8 @@ def _footprints(enu: np.ndarray, t: np.ndarray, label: np.ndarray, n_cells: np.n
     length_m = np.where(swap, extent_across, extent_along)
     width_m = np.where(swap, extent_along, extent_across)
     phi_long = np.where(swap, phi + 0.5 * np.pi, phi)
-    return _Footprint(mean_e, mean_n, mean_t, height_m, length_m, width_m, phi_long, starts)
+    return _Footprint(mean_e, mean_n, mean_t, height_m, length_m, width_m, phi_long, starts,
+                      np.maximum.reduceat(range_m[order], starts))
 
 
 def _outline_centres(enu: np.ndarray, label: np.ndarray, n_cells: np.ndarray, fp: _Footprint,
@@ -408,6 +421,14 @@ def _outline_centres(enu: np.ndarray, label: np.ndarray, n_cells: np.ndarray, fp
     centre_e = sensor_enu[:, 0] + centre_depth * u_e - centre_cross * u_n
     centre_n = sensor_enu[:, 1] + centre_depth * u_n + centre_cross * u_e
     return centre_e, centre_n
+
+
+def _range_cut(fp: _Footprint, config: LidarFrontEndConfig) -> np.ndarray:
+    """(k,) bool: the cluster's farthest point lies within ``range_cut_margin_m`` of the sensor's range limit, so its
+    object may go on beyond the limit, unseen (all False when the margin is None)."""
+    if config.range_cut_margin_m is None:
+        return np.zeros(fp.length_m.shape[0], dtype=bool)
+    return fp.farthest_m >= config.range_max_m - config.range_cut_margin_m
 
 
 def _cluster_cov(fp: _Footprint, los_e: np.ndarray, los_n: np.ndarray, horizontal_range_m: np.ndarray,

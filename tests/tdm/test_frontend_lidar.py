@@ -131,6 +131,24 @@ def test_a_compact_cluster_is_put_its_hidden_depth_behind_its_outline_and_a_long
     assert detect(wall).position_m[0] == pytest.approx(detect(wall, hidden_depth_fraction=0.0).position_m[0])
 
 
+def test_a_cluster_reaching_the_range_limit_is_flagged_cut_and_the_same_block_nearer_is_not():
+    """A 20 m square block turned 45 deg shows its two near faces from its front corner to its side corners,
+    14.1 m deeper. Centred 105 m north, they run from 90.9 m to past the 100 m limit: the sensor returns nothing
+    beyond it, so the cluster's farthest point lies at the limit and it is flagged (the block goes on, unseen).
+    Centred 60 m north, its farthest point is 60 m off: not flagged. Without a margin, nothing is."""
+    far, near = [(105.0, 0.0, 20.0, 20.0, 45.0, 6.0)], [(60.0, 0.0, 20.0, 20.0, 45.0, 6.0)]
+    det_far, det_near = detect(far), detect(near)
+    assert len(det_far) == len(det_near) == 1
+    assert det_far.range_cut.tolist() == [True] and det_near.range_cut.tolist() == [False]
+    assert detect(far, range_cut_margin_m=None).range_cut.tolist() == [False]
+    # the flag changes nothing else
+    unflagged = detect(far, range_cut_margin_m=None)
+    np.testing.assert_array_equal(det_far.position_m, unflagged.position_m)
+    np.testing.assert_array_equal(det_far.position_cov_m2, unflagged.position_cov_m2)
+    with pytest.raises(ValueError, match="range_cut_margin_m"):
+        LidarFrontEndConfig(range_cut_margin_m=-1.0)
+
+
 def test_walls_farther_apart_than_the_tolerance_are_two_clusters_closer_are_one():
     def walls(gap_m):
         return [(20.0, 3.0 + gap_m / 2, 6.0, 0.3, 90.0, 5.0), (20.0, -3.0 - gap_m / 2, 6.0, 0.3, 90.0, 5.0)]

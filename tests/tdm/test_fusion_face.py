@@ -125,3 +125,27 @@ def test_an_own_position_that_is_not_finite_counts_as_unknown():
         out[name] = fuser.step(1.0, {"radar": [first, second]}, own)
     assert len(out["none"]) == len(out["nan"]) == 1
     assert out["nan"][0].x == pytest.approx(out["none"][0].x) and out["nan"][0].p == pytest.approx(out["none"][0].p)
+
+
+def test_a_lidar_track_at_the_range_limit_reports_its_sigma_along_the_line_of_sight_only():
+    """A LiDAR track cut by the range limit, 60 m east and 80 m north of the own ship (line of sight (0.6, 0.8)):
+    sensor_tracks.jsonl's covariance grows by sigma^2 u u^T, nothing across; unflagged, nothing; the own ship
+    unknown, sigma^2 per axis."""
+    from tdm.fusion_face import range_cut_covariance, sensor_report
+
+    config = FusionConfig(consider_nav_bias=False)
+    track = make_track(1, "lidar", 60.0, 80.0)
+    own = np.array([0.0, 0.0])
+    _, plain = sensor_report("lidar", track, 0.0, own, config)
+    track.range_cut, track.range_cut_sigma_m = True, 7.0
+    x, cut = sensor_report("lidar", track, 0.0, own, config)
+    u = np.array([0.6, 0.8])
+    np.testing.assert_allclose(cut[:2, :2] - plain[:2, :2], 49.0 * np.outer(u, u), atol=1e-9)
+    np.testing.assert_array_equal(cut[2:, 2:], plain[2:, 2:])
+    assert x[:2] == pytest.approx([60.0, 80.0])
+    w = np.array([-0.8, 0.6])
+    assert w @ (cut[:2, :2] - plain[:2, :2]) @ w == pytest.approx(0.0, abs=1e-9)
+    np.testing.assert_allclose(range_cut_covariance(x[:2], None, 7.0), 49.0 * np.eye(2))
+    np.testing.assert_allclose(range_cut_covariance(x[:2], np.array([np.nan, 0.0]), 7.0), 49.0 * np.eye(2))
+    track.range_cut_sigma_m = 0.0
+    np.testing.assert_array_equal(sensor_report("lidar", track, 0.0, own, config)[1], plain)

@@ -248,3 +248,20 @@ def test_a_radar_tracks_core_width_is_the_running_mean_of_its_plots_and_a_ring_m
     lidar_dets = scan(0.0, [[100.0, 200.0]])
     lidar.process(lidar_dets, np.zeros(2))
     assert np.isnan(lidar.tracks[0].core_width_m)
+
+
+def test_a_track_knows_whether_its_last_detection_lay_at_the_range_limit():
+    """Detections.range_cut: the track is flagged while its latest detection is cut by the range limit, and carries the
+    configured consider sigma; detections without the flag (radar) leave it unflagged."""
+    tracker = PositionTracker("lidar", replace(CFG, range_cut_sigma_m=7.0))
+    cut_flags = [True, True, False, True]
+    for k, cut in enumerate(cut_flags):
+        dets = scan(float(k), [[0.0, 99.0]])
+        dets.sensor = "lidar"
+        dets.range_cut = np.array([cut])
+        tracker.process(dets, np.zeros(2))
+        (track,) = tracker.tracks
+        assert track.range_cut is cut and track.range_cut_sigma_m == 7.0
+    radar = PositionTracker("radar", CFG)
+    radar.process(scan(0.0, [[0.0, 99.0]]), np.zeros(2))
+    assert radar.tracks[0].range_cut is False and radar.tracks[0].range_cut_sigma_m == 0.0
