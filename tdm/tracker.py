@@ -48,6 +48,8 @@ _INIT_POSITION_VAR_M2 = 1.0
 #: and the weight of the new detection (exponential moving averages).
 LENGTH_KEEP, LENGTH_GAIN = 0.8, 0.2
 HEIGHT_KEEP, HEIGHT_GAIN = 0.9, 0.1
+#: Variance of a uniform distribution over a length L: L^2 / 12 (the part of an object seen before and not now).
+UNIFORM_VARIANCE_DIVISOR = 12.0
 #: Updates after which a track's length is smoothed rather than the largest seen (its first two
 #: detections may catch the object from one end).
 LENGTH_MAX_UPDATES = 2
@@ -132,6 +134,11 @@ class TrackerConfig:
         fusion it widened the track-to-track gates and absorbing radii and made the fused targets worse
         (busy_open_sea, seed 7, 300 s, radar 0.5: median error within LiDAR range 2.55 -> 3.52 m, COG
         RMSE 5.7 -> 10.2 deg; docs/tdm.md). 0: none.
+    footprint_width_fraction : float or None
+        Report the centre's uncertainty from the footprint over time (:attr:`Track.reported_extent_var_m2`: this
+        fraction of the footprint's width, and the length seen before and not now) in place of
+        ``extent_sigma_fraction`` of the length; the fusion's consider term keeps the length rule. None: the
+        length rule.
     range_cut_sigma_m : float
         A track last updated by a detection at the sensor's range limit (:attr:`~tdm.detections.Detections.range_cut`:
         a LiDAR cluster of an object that may go on beyond it) reports this standard deviation more along the line
@@ -162,6 +169,7 @@ class TrackerConfig:
     max_speed_mps: float = 20.0
     extent_sigma_fraction: float = 0.0
     range_cut_sigma_m: float = 0.0
+    footprint_width_fraction: float | None = None
     process: ekf.ProcessNoise = field(default_factory=ekf.ProcessNoise)
 
 
@@ -212,6 +220,10 @@ class Track:
     extent_sigma_fraction: float = 0.0
     range_cut: bool = False
     range_cut_sigma_m: float = 0.0
+    length_max_m: float = 0.0
+    length_now_m: float = 0.0
+    width_m: float = float("nan")
+    footprint_width_fraction: float | None = None
     _last_prediction: tuple | None = field(default=None, init=False, repr=False, compare=False)
 
     def predicted(self, t_s: float) -> tuple[np.ndarray, np.ndarray]:
@@ -242,13 +254,31 @@ class Track:
 
     def reported(self, t_s: float) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`predicted`, with the uncertainty of the object's centre behind the side the sensor sees
-        (``extent_sigma_fraction`` of ``length_m`` per axis, :class:`TrackerConfig`) added to the position's
-        covariance: what the track reports in ``sensor_tracks.jsonl``."""
+        (:attr:`reported_extent_var_m2` per axis) added to the position's covariance: what the track reports in
+        ``sensor_tracks.jsonl``."""
         x, p = self.predicted(t_s)
-        if self.extent_var_m2 > 0.0:
+        var = self.reported_extent_var_m2
+        if var > 0.0:
             p = p.copy()
-            p[:2, :2] += self.extent_var_m2 * np.eye(2)
+            p[:2, :2] += var * np.eye(2)
         return x, p
+
+    @property
+    def reported_extent_var_m2(self) -> float:
+        """Variance per axis of the object's centre behind the side seen, as the track reports it, m^2.
+
+        With a ``footprint_width_fraction`` f (:class:`TrackerConfig`; the LiDAR's): the footprint over time,
+        ``(f width_m)^2 + (length_max_m - length_now_m)^2 / 12``: the depth hidden behind the side seen scales with
+        the footprint's width (a berg's, or a hull's beam seen broadside), and a part of the object seen before and
+        not now (a hull seen end-on, or going out of range) may lie anywhere along the unseen length (uniform).
+        Without: :attr:`extent_var_m2`.
+        """
+        f = self.footprint_width_fraction
+        if f is None:
+            return self.extent_var_m2
+        width_m = self.width_m if np.isfinite(self.width_m) else 0.0
+        unseen_m = max(self.length_max_m - self.length_now_m, 0.0)
+        return float((f * width_m) ** 2 + unseen_m ** 2 / UNIFORM_VARIANCE_DIVISOR)
 
     @property
     def extent_var_m2(self) -> float:
@@ -257,6 +287,20 @@ class Track:
         if self.extent_sigma_fraction > 0.0 and np.isfinite(self.length_m) and self.length_m > 0.0:
             return float((self.extent_sigma_fraction * self.length_m) ** 2)
         return 0.0
+
+
+def _footprint_over_time(track: Track, dets: Detections, j: int) -> None:
+    """Track the footprint over time from detection ``j``: the largest length seen (one detection counts as at most
+    LENGTH_JUMP times the largest so far, as for the smoothed length), the latest length, and the width smoothed as
+    the length is after its first updates (NaN sizes skipped)."""
+    length_m = float(dets.length_m[j])
+    if np.isfinite(length_m):
+        track.length_now_m = length_m
+        track.length_max_m = length_m if track.length_max_m <= 0.0 else \
+            max(track.length_max_m, min(length_m, LENGTH_JUMP * track.length_max_m))
+    width_m = float(dets.width_m[j])
+    if np.isfinite(width_m):
+        track.width_m = width_m if not np.isfinite(track.width_m) else LENGTH_KEEP * track.width_m + LENGTH_GAIN * width_m
 
 
 def predicted_at(tracks: list[Track], t_s: float) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -369,6 +413,7 @@ class PositionTracker:
         track.n_updates += 1
         track.range_cut = dets.range_cut is not None and bool(dets.range_cut[j])
         track.length_m = _smoothed_size(track.length_m, float(dets.length_m[j]), track.n_updates)
+        _footprint_over_time(track, dets, j)
         if dets.core_width_m is not None:
             core_m = float(dets.core_width_m[j])
             gain = 1.0 / min(track.n_updates, CORE_WIDTH_UPDATES)
@@ -424,7 +469,9 @@ class PositionTracker:
                       height_m=float(dets.height_m[j]), length_m=float(dets.length_m[j]), process=cfg.process,
                       core_width_m=float(dets.core_width_m[j]) if dets.core_width_m is not None else float("nan"),
                       extent_sigma_fraction=cfg.extent_sigma_fraction, range_cut_sigma_m=cfg.range_cut_sigma_m,
-                      range_cut=dets.range_cut is not None and bool(dets.range_cut[j]))
+                      range_cut=dets.range_cut is not None and bool(dets.range_cut[j]),
+                      footprint_width_fraction=cfg.footprint_width_fraction)
+        _footprint_over_time(track, dets, j)
         self._record(track, self._hit_weight(dets, j))
         self.tracks.append(track)
 

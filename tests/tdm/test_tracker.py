@@ -265,3 +265,28 @@ def test_a_track_knows_whether_its_last_detection_lay_at_the_range_limit():
     radar = PositionTracker("radar", CFG)
     radar.process(scan(0.0, [[0.0, 99.0]]), np.zeros(2))
     assert radar.tracks[0].range_cut is False and radar.tracks[0].range_cut_sigma_m == 0.0
+
+
+def test_a_lidar_track_reports_its_footprint_over_time():
+    """footprint_width_fraction f: the reported variance per axis is (f W)^2 plus the length seen before and not now,
+    uniform, (L_max - L_now)^2 / 12. A hull seen whole (60 m), then end-on (20 m) with a 6 m width: 0.2 x 6 = 1.2 m
+    and 40 m unseen. A detection over three times the largest length so far counts as three times it. The filter
+    and the fusion's term (extent_var_m2, the length rule) are not changed."""
+    cfg = replace(CFG, extent_sigma_fraction=0.15, footprint_width_fraction=0.2)
+    tracker, plain = PositionTracker("lidar", cfg), PositionTracker("lidar", replace(cfg, footprint_width_fraction=None))
+    for k, length in enumerate([60.0, 60.0, 20.0]):
+        dets = scan(float(k), [[0.0, 50.0]])
+        dets.length_m, dets.width_m = np.array([length]), np.array([6.0])
+        tracker.process(dets, np.zeros(2))
+        plain.process(dets, np.zeros(2))
+    (track,), (other,) = tracker.tracks, plain.tracks
+    assert (track.length_max_m, track.length_now_m, track.width_m) == (60.0, 20.0, pytest.approx(6.0))
+    assert track.reported_extent_var_m2 == pytest.approx(1.2 ** 2 + 40.0 ** 2 / 12.0)
+    np.testing.assert_array_equal(track.p, other.p)
+    assert track.extent_var_m2 == other.extent_var_m2 == other.reported_extent_var_m2 > 0.0
+    _, p = track.reported(3.0)
+    np.testing.assert_allclose(p[:2, :2] - track.predicted(3.0)[1][:2, :2], track.reported_extent_var_m2 * np.eye(2))
+    swollen = scan(3.0, [[0.0, 50.0]])
+    swollen.length_m, swollen.width_m = np.array([1000.0]), np.array([6.0])
+    tracker.process(swollen, np.zeros(2))
+    assert tracker.tracks[0].length_max_m == pytest.approx(180.0)
