@@ -53,7 +53,7 @@ class TdmConfig:
         extent_sigma_fraction=0.15,
         # a cluster at the range limit shows only the part of its object within 100 m: on busy_open_sea seeds 31-35
         # the LiDAR tracks at 98 m or more lay a mean 4-7 m in front of their objects' centres along the line of
-        # sight (rms 9-13 m) while reporting 2.2-3.0 m; 5, 7 and 10 m tried there, 7 best on four seeds of five
+        # sight (rms 9-13 m) while reporting 2.2-3.0 m; 5, 7 and 10 m tried there, 7 best or level on every seed
         # (docs/tdm.md, "Consistent per-sensor covariances")
         range_cut_sigma_m=7.0,
         # the reported centre uncertainty from the footprint over time: 0.2 of its width, plus the length seen
