@@ -112,11 +112,13 @@ def sensor_report(sensor: str, track: Track, t_s: float, own_m: np.ndarray | Non
     own ship's navigation bias added to a LiDAR or radar track's position covariance (``consider_nav_bias``,
     :func:`tdm.nav_bias.nav_bias_covariance`; ``own_m`` (2,) m, the own ship's position, None if unknown)."""
     x, p = face_report(track, t_s, own_m, config) if sensor == "radar" else track.reported(t_s)
-    if config.consider_nav_bias and sensor in NAV_RELATIVE_SENSORS:
+    nav = config.consider_nav_bias and sensor in NAV_RELATIVE_SENSORS
+    cut = track.range_cut and track.range_cut_sigma_m > 0.0
+    if nav or cut:
         p = p.copy()
+    if nav:
         p[:2, :2] += nav_bias_covariance(x[:2], own_m, config.nav_position_bias_m, config.nav_heading_bias_deg)
-    if track.range_cut and track.range_cut_sigma_m > 0.0:
-        p = p.copy()
+    if cut:
         p[:2, :2] += range_cut_covariance(x[:2], own_m, track.range_cut_sigma_m)
     return x, p
 
@@ -125,13 +127,8 @@ def range_cut_covariance(position_m: np.ndarray, own_m: np.ndarray | None, sigma
     """(2, 2) covariance, m^2: ``sigma_m`` along the line of sight from ``own_m`` (2,) to ``position_m`` (2,), m, for
     a track whose object may go on beyond the sensor's range limit (:attr:`tdm.tracker.TrackerConfig.range_cut_sigma_m`);
     ``sigma_m`` per axis where the own ship is unknown (None or not finite) or on the track."""
-    if own_m is not None and np.all(np.isfinite(own_m)):
-        sight = np.asarray(position_m, dtype=float) - np.asarray(own_m, dtype=float)[:2]
-        distance = float(np.hypot(*sight))
-        if distance > 0.0:
-            u = sight / distance
-            return sigma_m ** 2 * np.outer(u, u)
-    return sigma_m ** 2 * np.eye(2)
+    u = None if own_m is None else _sight(position_m, own_m)[0]
+    return sigma_m ** 2 * (np.eye(2) if u is None else np.outer(u, u))
 
 
 def sight_covariance(track: Track, x: np.ndarray, own_m: np.ndarray, config: FusionConfig) -> np.ndarray:
@@ -149,10 +146,17 @@ def _sight_and_depth(track: Track, x: np.ndarray, own_m: np.ndarray, config: Fus
     """The unit line of sight (2,) from ``own_m`` (2,, m) to the track's position ``x[:2]`` (m), None where the
     track lies on the own ship, and the track's hidden depth and its standard deviation there, m
     (:func:`hidden_depth_m`)."""
-    sight = x[:2] - np.asarray(own_m, dtype=float)[:2]
-    distance = float(np.hypot(*sight))
+    u, distance = _sight(x, own_m)
     depth_m, sigma_m = hidden_depth_m(track, distance, config)
-    return (sight / distance if distance > 0.0 else None), depth_m, sigma_m
+    return u, depth_m, sigma_m
+
+
+def _sight(position_m: np.ndarray, own_m: np.ndarray) -> tuple[np.ndarray | None, float]:
+    """The unit line of sight (2,) from ``own_m`` (2,, m) to ``position_m[:2]`` (m), None where they coincide or
+    either is not finite, and the distance, m."""
+    sight = np.asarray(position_m, dtype=float)[:2] - np.asarray(own_m, dtype=float)[:2]
+    distance = float(np.hypot(*sight))
+    return (sight / distance if distance > 0.0 else None), distance
 
 
 def face_covariance(target: FusedTarget, moved: bool, x: np.ndarray, track: Track, own_m: np.ndarray | None,

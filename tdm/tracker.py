@@ -289,10 +289,12 @@ class Track:
         return 0.0
 
 
-def _footprint_over_time(track: Track, dets: Detections, j: int) -> None:
-    """Track the footprint over time from detection ``j``: the largest length seen (one detection counts as at most
-    LENGTH_JUMP times the largest so far, as for the smoothed length), the latest length, and the width smoothed as
-    the length is after its first updates (NaN sizes skipped)."""
+def _record_shape(track: Track, dets: Detections, j: int) -> None:
+    """What detection ``j`` tells the track of its object's shape: whether it lay at the sensor's range limit
+    (:attr:`~tdm.detections.Detections.range_cut`), and the footprint over time: the largest length seen (one
+    detection counts as at most LENGTH_JUMP times the largest so far, as for the smoothed length), the latest length,
+    and the width smoothed as the length is after its first updates (NaN sizes skipped)."""
+    track.range_cut = dets.range_cut is not None and bool(dets.range_cut[j])
     length_m = float(dets.length_m[j])
     if np.isfinite(length_m):
         track.length_now_m = length_m
@@ -411,9 +413,8 @@ class PositionTracker:
         track.x, track.p, _ = ekf.update(x, p, z, ekf.H_POSITION_SIZE, r)
         track.t_s = track.updated_s = t
         track.n_updates += 1
-        track.range_cut = dets.range_cut is not None and bool(dets.range_cut[j])
         track.length_m = _smoothed_size(track.length_m, float(dets.length_m[j]), track.n_updates)
-        _footprint_over_time(track, dets, j)
+        _record_shape(track, dets, j)
         if dets.core_width_m is not None:
             core_m = float(dets.core_width_m[j])
             gain = 1.0 / min(track.n_updates, CORE_WIDTH_UPDATES)
@@ -469,9 +470,8 @@ class PositionTracker:
                       height_m=float(dets.height_m[j]), length_m=float(dets.length_m[j]), process=cfg.process,
                       core_width_m=float(dets.core_width_m[j]) if dets.core_width_m is not None else float("nan"),
                       extent_sigma_fraction=cfg.extent_sigma_fraction, range_cut_sigma_m=cfg.range_cut_sigma_m,
-                      range_cut=dets.range_cut is not None and bool(dets.range_cut[j]),
                       footprint_width_fraction=cfg.footprint_width_fraction)
-        _footprint_over_time(track, dets, j)
+        _record_shape(track, dets, j)
         self._record(track, self._hit_weight(dets, j))
         self.tracks.append(track)
 
