@@ -161,6 +161,20 @@ def criteria_lines(heldout: dict) -> list[str]:
         every = sum(all(ok for ok in v.values() if ok is not None) for v in mine)
         tag = " (tuned)" if scenario == TUNED else ""
         lines.append(f"| {scenario}{tag} | {len(mine)} | " + " | ".join(counts) + f" | {every}/{len(mine)} |")
+    return lines + [""] + switch_lines(runs)
+
+
+def switch_lines(runs: list[dict]) -> list[str]:
+    """Markdown: per run, the most id switches of one object, CLEAR MOT's and the per-epoch assignment's."""
+    lines = ["Id switches are counted on the CLEAR MOT correspondence (tdm/eval_identity.py; Bernardin and "
+             "Stiefelhagen 2008, as py-motmetrics): an object keeps its target while that target stays within the "
+             "cut-off. Counted on the optimal assignment at each epoch instead (the evaluation's count until "
+             "2026-11-29), the most switches of one object per run, seeds in order:", "",
+             "| scenario | CLEAR MOT (the criterion) | per-epoch assignment |", "|---|---|---|"]
+    for scenario in dict.fromkeys(r["scenario"] for r in runs):
+        mine = [r for r in runs if r["scenario"] == scenario]
+        lines.append(f"| {scenario} | {', '.join(str(r.get('id_switches_max')) for r in mine)} | "
+                     + ", ".join(str(r.get("id_switches_per_epoch_assignment_max", "-")) for r in mine) + " |")
     return lines
 
 

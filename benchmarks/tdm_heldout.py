@@ -103,6 +103,8 @@ def run_criteria(metrics: dict, closest: dict[str, float]) -> dict:
         "median_error_beyond_lidar_m": metrics["median_position_error_beyond_lidar_range_m"],
         "id_switches_max": metrics["id_switches_max_per_object"],
         "id_switches_by_object": {o["name"]: o["id_switches"] for o in metrics["per_object"] if o["id_switches"]},
+        "id_switches_per_epoch_assignment_max": max(
+            (o.get("id_switches_per_epoch_assignment", 0) for o in metrics["per_object"]), default=0),
         "false_targets_per_min": metrics["false_targets_per_min"],
         "nees_fraction_in_95": metrics["nees_fraction_in_95"],
         "gospa_m": metrics.get("gospa_m"),

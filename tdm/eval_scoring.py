@@ -12,6 +12,7 @@ import math
 import numpy as np
 
 from tdm.eval_best_sensor import pair_errors
+from tdm.eval_identity import carry_forward_assignment, switches
 from tdm.eval_truth import TruthAtEpochs
 from tdm.metrics import GOSPA_ALPHA, assign_distances, distance_matrix, gospa_distances, ospa_distances
 
@@ -73,8 +74,11 @@ def subset(reports: dict[str, np.ndarray], mask: np.ndarray) -> dict[str, np.nda
 
 def _assign(truth: TruthAtEpochs, visible: np.ndarray, rep_pos: np.ndarray, report_epoch: np.ndarray,
             c_m: float, p: float, dont_care: np.ndarray | None, on_land: np.ndarray | None = None,
-            near: tuple[float, float] | None = None) -> dict:
+            near: tuple[float, float] | None = None, target_id: np.ndarray | None = None) -> dict:
     """Per epoch: the assignment, OSPA and GOSPA terms; the matched pairs (epoch, object, report, distance).
+
+    With ``target_id`` (N,): also the CLEAR MOT correspondence (:mod:`tdm.eval_identity`), ``mot_tid``
+    (E, K), each object's matched target id per epoch (-1: not matched), for the id switches.
 
     A report ``on_land`` (N,) is at least the cut-off from every object: never matched nor ignored,
     a false report (and a cardinality error in OSPA and GOSPA). ``near`` (range m, cut-off m): also GOSPA
@@ -93,6 +97,9 @@ def _assign(truth: TruthAtEpochs, visible: np.ndarray, rep_pos: np.ndarray, repo
     n_rep_e = np.diff(bounds)
     pairs_e, pairs_k, pairs_r, pairs_d = [], [], [], []
     is_ignored = np.zeros(report_epoch.size, dtype=bool)
+    K = visible.shape[1]
+    mot_tid = np.full((E, K), -1, dtype=np.int64)
+    last_tid = np.full(K, -1, dtype=np.int64)
     for e in range(E):  # loop over epochs (scans); each assignment is a small matrix
         rows = order[bounds[e]:bounds[e + 1]]
         ks = np.flatnonzero(visible[e])
@@ -116,6 +123,9 @@ def _assign(truth: TruthAtEpochs, visible: np.ndarray, rep_pos: np.ndarray, repo
                 _off_land(distance_matrix(truth_pos[e, ks[close_k]], rep_pos[rows[close_r]]), land[rows[close_r]],
                           near[1]), near[1], p, GOSPA_ALPHA)["total"]
         r, cc = assign_distances(d, c_m, p)
+        if target_id is not None:
+            mr, mc = carry_forward_assignment(d, target_id[rows], last_tid[ks], c_m, p)
+            mot_tid[e, ks[mr]] = last_tid[ks[mr]] = target_id[rows[mc]]
         pairs_e.append(np.full(r.size, e))
         pairs_k.append(ks[r])
         pairs_r.append(rows[cc])
@@ -124,7 +134,7 @@ def _assign(truth: TruthAtEpochs, visible: np.ndarray, rep_pos: np.ndarray, repo
                   for x in (pairs_e, pairs_k, pairs_r))
     pd = np.concatenate(pairs_d) if pairs_d else np.zeros(0)
     return {"per_epoch": per_epoch, "n_rep_e": n_rep_e, "kept": kept, "is_ignored": is_ignored,
-            "pe": pe, "pk": pk, "pr": pr, "pd": pd, "truth_pos": truth_pos}
+            "pe": pe, "pk": pk, "pr": pr, "pd": pd, "truth_pos": truth_pos, "mot_tid": mot_tid}
 
 
 def _off_land(d_m: np.ndarray, on_land: np.ndarray, c_m: float) -> np.ndarray:
@@ -181,7 +191,7 @@ def _per_object(truth: TruthAtEpochs, visible: np.ndarray, reports: dict[str, np
     err_mat = np.full((E, K), np.nan)
     err_mat[a["pe"], a["pk"]] = a["pd"]
     per_object, latency, missed = [], {}, []
-    switches_total, switches_max = 0, 0
+    switches_total, switches_max, optimal_total = 0, 0, 0
     for k in range(K):  # loop over objects
         vis_e = np.flatnonzero(visible[:, k])
         if vis_e.size == 0:
@@ -190,9 +200,11 @@ def _per_object(truth: TruthAtEpochs, visible: np.ndarray, reports: dict[str, np
         start_e = sustained_start(vis_e, t_s)
         lat_s = max(float(t_s[m_e[0]] - t_s[start_e]), 0.0) if m_e.size else None
         glimpse_lat_s = float(t_s[m_e[0]] - t_s[vis_e[0]]) if m_e.size else None
-        switches = int(np.count_nonzero(np.diff(matched_tid[m_e, k]))) if m_e.size else 0
-        switches_total += switches
-        switches_max = max(switches_max, switches)
+        n_switches = switches(a["mot_tid"][:, k])
+        n_optimal = switches(matched_tid[:, k])
+        switches_total += n_switches
+        optimal_total += n_optimal
+        switches_max = max(switches_max, n_switches)
         name = truth.names[k] if truth.names.count(truth.names[k]) == 1 else f"{truth.names[k]}#{truth.ids[k]}"
         latency[name] = lat_s
         if lat_s is None:
@@ -201,7 +213,8 @@ def _per_object(truth: TruthAtEpochs, visible: np.ndarray, reports: dict[str, np
                            "first_in_range_s": float(t_s[vis_e[0]]), "in_view_from_s": float(t_s[start_e]),
                            "epochs_in_range": int(vis_e.size), "latency_from_first_in_range_s": glimpse_lat_s,
                            "epochs_matched": int(m_e.size), "matched_fraction": m_e.size / vis_e.size,
-                           "latency_s": lat_s, "id_switches": switches,
+                           "latency_s": lat_s, "id_switches": n_switches,
+                           "id_switches_per_epoch_assignment": n_optimal,
                            "target_ids": sorted({int(x) for x in matched_tid[m_e, k]}),
                            "median_error_m": _median(err_mat[m_e, k])})
     latencies = np.array([v for v in latency.values() if v is not None])
@@ -212,7 +225,8 @@ def _per_object(truth: TruthAtEpochs, visible: np.ndarray, reports: dict[str, np
             "detection_latency_from_first_in_range_max_s": float(np.max(from_first)) if from_first.size else math.nan,
             "detection_latency_mean_s": _mean(latencies),
             "objects_in_range": len(latency), "missed_objects": sorted(missed),
-            "id_switches": switches_total, "id_switches_max_per_object": switches_max, "per_object": per_object}
+            "id_switches": switches_total, "id_switches_max_per_object": switches_max,
+            "id_switches_per_epoch_assignment": optimal_total, "per_object": per_object}
 
 
 def _false(reports: dict[str, np.ndarray], report_epoch: np.ndarray, a: dict, duration_s: float) -> dict:
@@ -284,7 +298,8 @@ def score(truth: TruthAtEpochs, visible: np.ndarray, reports: dict[str, np.ndarr
     E = visible.shape[0]
     rep_pos = np.stack([reports["east_m"], reports["north_m"]], axis=-1)  # (N, 2)
     on_land = reports.get("on_land")
-    a = _assign(truth, visible, rep_pos, report_epoch, c_m, p, dont_care, on_land, (lidar_range_m, NEAR_GOSPA_C_M))
+    a = _assign(truth, visible, rep_pos, report_epoch, c_m, p, dont_care, on_land, (lidar_range_m, NEAR_GOSPA_C_M),
+                reports["target_id"])
     per_epoch, pd = a["per_epoch"], a["pd"]
     n_visible = int(visible.sum())
     out = {name: float(np.mean(per_epoch[key])) if E else math.nan

@@ -78,9 +78,15 @@ False targets
     ids / (manifest ``duration_s`` / 60). ``false_reports_per_min`` = unmatched, not
     ignored (target, epoch) reports per minute.
 ID switches
-    Per truth object, the number of changes of the matched target id between its consecutive
-    matched epochs (gaps do not count as switches); ``id_switches`` is the total,
-    ``id_switches_max_per_object`` the largest.
+    Per truth object, the number of changes of its matched target id between its consecutive
+    matched epochs (gaps do not count as switches), the matching being the CLEAR MOT
+    correspondence (Bernardin and Stiefelhagen 2008; py-motmetrics): an object keeps its last
+    target while that target is reported within the cut-off of it, and the rest are assigned
+    optimally (:mod:`tdm.eval_identity`); ``id_switches`` is the total,
+    ``id_switches_max_per_object`` the largest. ``id_switches_per_epoch_assignment``: the same
+    count on the optimal assignment at each epoch (the errors' matching; the count of
+    2026-11-29 and before), which also counts the hand-overs of two targets between two objects
+    each about as far from both.
 NEES
     Per matched pair, ``e^T P^-1 e`` with e the 2-D ENU position error and P the reported
     ``position_cov_m2`` (pairs without a positive-definite P are skipped); ``nees`` is the mean
@@ -177,7 +183,9 @@ DEFINITIONS = {
                       "(reports_on_land: such (target, epoch) reports)",
     "ignored_reports": "reports assigned to objects within a sensor's range but hidden from every sensor (ray "
                        "truth): neither matched nor false",
-    "id_switches": "total over objects of changes of matched target id between consecutive matched epochs",
+    "id_switches": "total over objects of changes of matched target id between consecutive matched epochs, "
+                   "on the CLEAR MOT correspondence (a kept target is not re-assigned while within the cut-off)",
+    "id_switches_per_epoch_assignment": "the same count on the optimal assignment at each epoch",
     "nees": "mean of e^T P^-1 e over matched pairs (ideal 2); nees_fraction_in_95: inside [0.0506, 7.378]",
     "classification_accuracy": "matched ship/iceberg pairs whose descriptor is vessel/iceberg",
     "per_sensor": "same metrics per sensor of sensor_tracks.jsonl against that sensor's in-range objects",
