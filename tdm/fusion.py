@@ -5,7 +5,9 @@
   joins the nearest target that has no track of its sensor, by GNN on the track-to-track
   statistic ``d^2 = dx^T (P_i + P_j)^-1 dx`` on position (gate chi-square 2 dof), else it
   starts a new target. An AIS track is matched to targets the same way, so a ship keeps its
-  id when its AIS arrives after the radar saw it. Target ids are never reused.
+  id when its AIS arrives after the radar saw it. Target ids are never reused for another object: a
+  target that ended comes back under its id only where it was (``revive_s``), and a track that was folded
+  with its target into another (same object, below) and leaves it again takes its own target's id back.
 - **Extended objects.** A large ship gives several radar plots (bow, bridge, stern) and an
   iceberg several LiDAR clusters, hence several tracks of one sensor. A track that joins no
   target but lies near the footprint of a target (within ``absorb_lengths`` (0.75) of its length,
@@ -122,6 +124,7 @@ class Fuser:
         self.lengths_by_mmsi: dict[int, float] = {}
         self.beams_by_mmsi: dict[int, float] = {}
         self._ended: list[FusedTarget] = []
+        self._folded: dict[tuple[str, int], FusedTarget] = {}  # track -> the target it held before a merge
         self._ids = itertools.count(1)
         self._gate = chi2_gate(config.gate_probability, POSITION_DOF)
         self._moving_since: dict[int, float] = {}
@@ -153,6 +156,7 @@ class Fuser:
         cfg = self.config
         live = {(s, tr.track_id): tr for s, trs in tracks_by_sensor.items() for tr in trs}
         states = dict(zip(live, predicted_at(list(live.values()), t_s)))  # at once; kept for the output
+        self._folded = {k: t for k, t in self._folded.items() if k in live}
         moved = set()
         if own_position_m is not None and cfg.radar_hidden_depth_fraction > 0.0:
             moved = behind_the_face(self.targets, states, live, own_position_m, cfg)
@@ -239,8 +243,19 @@ class Fuser:
         elif host is not None:
             host.absorbed.add(key)
         if host is None:
-            self.targets.append(self._revive(states[key], t_s) or FusedTarget(next(self._ids), created_s=t_s))
+            self.targets.append(self._unfold(key) or self._revive(states[key], t_s)
+                                or FusedTarget(next(self._ids), created_s=t_s))
             self.targets[-1].members = {sensor: tr.track_id}
+
+    def _unfold(self, key: tuple[str, int]) -> FusedTarget | None:
+        """The target that track ``key`` held before it was folded into another (:meth:`_merge_overlapping`), when
+        the track leaves that other one and starts a target again: the track is the same, so is its id (unless
+        another of its tracks took the id back first)."""
+        target = self._folded.pop(key, None)
+        if target is None or any(t.target_id == target.target_id for t in self.targets):
+            return None
+        target.absorbed = set()
+        return target
 
     def _holds(self, target: FusedTarget, sensor: str, state: tuple, live: dict, states: dict, unresolved_m: float,
                ship_m: float, own_position_m: np.ndarray | None) -> bool:
@@ -453,6 +468,9 @@ class Fuser:
                     continue
                 if n_ais == 1 and _moves_apart(est[older.target_id], (xy, py), "ais" in older.members):
                     continue
+                self._folded.update({key: younger for key in younger.members.items()})
+                for key in younger.absorbed:
+                    self._folded.setdefault(key, younger)
                 for sensor, track_id in younger.members.items():
                     if sensor in older.members:
                         older.absorbed.add((sensor, track_id))

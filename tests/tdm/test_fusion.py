@@ -203,6 +203,25 @@ def test_a_radar_target_inside_an_ais_ship_folds_into_the_older_target():
     assert out[0].target.mmsi == 257000002
 
 
+def test_a_track_that_leaves_the_target_it_was_folded_into_takes_its_own_id_back():
+    fuser = Fuser(FusionConfig())
+    lidar = make_track(1, "lidar", 0.0, 0.0, var=1.0)
+    fuser.step(1.0, {"lidar": [lidar], "radar": []})
+    out = fuser.step(2.0, {"lidar": [lidar], "radar": [make_track(4, "radar", 300.0, 0.0, var=25.0, t=2.0)]})
+    ids = {round(e.x[0]): e.target.target_id for e in out}
+    assert len(ids) == 2
+    # the radar track comes within the LiDAR target's footprint: one object, the older target's id
+    (merged,) = fuser.step(3.0, {"lidar": [lidar], "radar": [make_track(4, "radar", 3.0, 0.0, var=25.0, t=3.0)]})
+    assert merged.target.target_id == ids[0] and merged.sources == ["lidar", "radar"]
+    # the same radar track leaves again: it is the target it was, not a new one
+    out = fuser.step(4.0, {"lidar": [lidar], "radar": [make_track(4, "radar", 300.0, 0.0, var=25.0, t=4.0)]})
+    assert {round(e.x[0]): e.target.target_id for e in out} == ids
+    # a new track there later is a new target (ids are not handed out twice)
+    out = fuser.step(5.0, {"lidar": [lidar], "radar": [make_track(4, "radar", 300.0, 0.0, var=25.0, t=5.0),
+                                                        make_track(9, "radar", 700.0, 0.0, var=25.0, t=5.0)]})
+    assert len({e.target.target_id for e in out}) == 3
+
+
 def test_a_ship_passing_close_to_a_still_berg_does_not_swallow_it():
     """busy_open_sea seeds 9 and 11: a 100 m ship with AIS passes 40 m from a berg the radar has tracked
     for a while; the berg's target is not folded into the ship's (two objects), and keeps its id."""
