@@ -60,6 +60,16 @@ def test_every_run_is_a_row_and_its_failures_name_their_objects():
     assert summary.endswith("| 0/1 | 1/1 | 1/1 | 1/1 | 0/1 | 1/1 | 0/1 | 0/1 |")
 
 
+def test_both_id_switch_counts_are_shown_per_scenario_seeds_in_order():
+    bench = _benchmark_module()
+    runs = [_run("harbour_approach", 31, id_switches_max=5, id_switches_per_epoch_assignment_max=15),
+            _run("harbour_approach", 32, id_switches_max=6, id_switches_per_epoch_assignment_max=9),
+            _run("busy_open_sea", 31)]  # a run made before the per-epoch count was kept
+    lines = bench.switch_lines(runs)
+    assert "| harbour_approach | 5, 6 | 15, 9 |" in lines
+    assert "| busy_open_sea | 0 | - |" in lines
+
+
 def test_a_missing_or_old_heldout_file_is_one_line_and_exit_2(tmp_path, capsys):
     bench = _benchmark_module()
     assert bench.main(["--heldout", str(tmp_path / "none.json"), "--out", str(tmp_path / "x.md")]) == 2
