@@ -254,6 +254,8 @@ class Fuser:
         target = self._folded.pop(key, None)
         if target is None or any(t.target_id == target.target_id for t in self.targets):
             return None
+        if target in self._ended:  # taken back by another of its tracks since, and ended again
+            self._ended.remove(target)
         target.absorbed = set()
         return target
 

@@ -222,6 +222,31 @@ def test_a_track_that_leaves_the_target_it_was_folded_into_takes_its_own_id_back
     assert len({e.target.target_id for e in out}) == 3
 
 
+def test_a_target_taken_back_by_its_second_track_is_no_longer_among_the_ended():
+    fuser = Fuser(FusionConfig(revive_s=30.0, revive_slow_as_still=False))
+    lidar = make_track(1, "lidar", 0.0, 0.0, var=1.0)
+
+    def step(t, radar=(), lidar2=None):
+        tracks = {"lidar": [lidar] + ([make_track(2, "lidar", *lidar2, var=1.0, t=t)] if lidar2 else []),
+                  "radar": [make_track(4, "radar", *xy, var=25.0, t=t) for xy in radar]}
+        out = {e.target.target_id: e for e in fuser.step(t, tracks)}
+        # a live target is never also one that ended (which a new track could revive: one id on two targets)
+        assert not [x for x in fuser.targets if x in fuser._ended]
+        return out
+
+    step(1.0)
+    two = set(step(2.0, radar=[(300.0, 0.0)], lidar2=(301.0, 0.0))) - {1}
+    assert len(two) == 1
+    (b,) = two
+    assert set(step(3.0, radar=[(3.0, 0.0)], lidar2=(2.0, 1.0))) == {1}  # both of b's tracks folded into 1
+    assert set(step(4.0, radar=[(300.0, 0.0)], lidar2=(2.0, 1.0))) == {1, b}  # its radar track takes b back
+    assert set(step(5.0, lidar2=(2.0, 1.0))) == {1}  # that track ends, and b with it
+    assert set(step(6.0, lidar2=(600.0, 0.0))) == {1, b}  # its LiDAR track leaves 1 and takes b back
+    out = step(7.0, radar=[(300.0, 0.0)], lidar2=(600.0, 0.0))  # a new track where b ended: not b a second time
+    ids = [e.target.target_id for e in out.values()]
+    assert len(out) == 3 and ids.count(b) == 1
+
+
 def test_a_ship_passing_close_to_a_still_berg_does_not_swallow_it():
     """busy_open_sea seeds 9 and 11: a 100 m ship with AIS passes 40 m from a berg the radar has tracked
     for a while; the berg's target is not folded into the ship's (two objects), and keeps its id."""
