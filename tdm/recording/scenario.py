@@ -5,11 +5,15 @@ The file must be UTF-8 YAML holding a mapping. Of its keys only those the TDM us
 within its bounds (whole for counts), so a rate of NaN, 0 or 1e9 Hz, a mount of ``"high"`` or a
 spoke count of 2048.5 is an error naming its key path, never a division by zero or an allocation
 sized by a wild number. Sections the TDM reads (``tdm``, ``sensors``, ``sensors.<name>``, their
-``mount`` and ``own_ship``) must be mappings when present.
+``mount`` and ``own_ship``) must be mappings when present. A key in one of them that is not one the TDM
+reads but is within a typo of one the section lacks (``update_rate_hzz`` where ``update_rate_hz`` is
+missing: :func:`difflib.get_close_matches`, :data:`MISSPELT_RATIO`) is an error: a hand-edited recording would
+otherwise run on the default. The other keys raysim writes there are not the TDM's to judge.
 """
 
 from __future__ import annotations
 
+import difflib
 from pathlib import Path
 
 import yaml
@@ -50,8 +54,27 @@ CHECKED: dict[str, tuple[str, float, float]] = {
     "sensors.nav.heading_bias_deg": ("number", 0.0, 360.0),
     **{f"sensors.{s}.mount.{k}": v for s in ("lidar", "radar") for k, v in _MOUNT.items()},
 }
-_SECTIONS = ("tdm", "own_ship", "sensors", *(f"sensors.{s}" for s in ("lidar", "radar", "ais", "nav")),
+_SENSORS = ("lidar", "radar", "ais", "nav")
+_SECTIONS = ("tdm", "own_ship", "sensors", *(f"sensors.{s}" for s in _SENSORS),
              "sensors.lidar.mount", "sensors.radar.mount")
+#: How alike (difflib ratio) a key must be to a known key its section lacks to be taken for its misspelling: one
+#: character added or dropped (keys of four characters or more) or changed (seven or more) is over it; the closest
+#: key raysim writes beside the TDM's, ``sensors.radar.beam_el_deg`` to ``beam_az_deg``, is 0.82.
+MISSPELT_RATIO = 0.85
+
+
+def _known_keys() -> dict[str, frozenset[str]]:
+    """Section -> the keys the TDM reads in it (:data:`CHECKED`, and each sensor's ``enabled`` and ``mount``)."""
+    known: dict[str, set[str]] = {section: set() for section in _SECTIONS if section != "sensors"}
+    for key_path in CHECKED:
+        section, _, key = key_path.rpartition(".")
+        known[section].add(key)
+    for sensor in _SENSORS:
+        known[f"sensors.{sensor}"] |= {"enabled", "mount"} if sensor in ("lidar", "radar") else {"enabled"}
+    return {section: frozenset(keys) for section, keys in known.items()}
+
+
+_KNOWN = _known_keys()
 
 
 def _lookup(data: dict, key_path: str):
@@ -72,7 +95,8 @@ def check_scenario(data: object, path: Path) -> dict:
         value = _lookup(data, section)
         if value is not None:
             values.mapping(value, path, section)
-    for sensor in ("lidar", "radar", "ais", "nav"):
+    _check_misspelt(data, path)
+    for sensor in _SENSORS:
         enabled = _lookup(data, f"sensors.{sensor}.enabled")
         if enabled is not None:
             values.boolean(enabled, path, f"sensors.{sensor}.enabled")
@@ -85,6 +109,21 @@ def check_scenario(data: object, path: Path) -> dict:
         else:
             values.number(value, path, key_path, low, high, low_open=kind == "rate")
     return data
+
+
+def _check_misspelt(data: dict, path: Path) -> None:
+    """A RecordingError for the first key of a section the TDM reads that looks like a misspelling of a key the
+    section lacks (module docstring)."""
+    for section, known in _KNOWN.items():
+        node = _lookup(data, section)
+        if not isinstance(node, dict):
+            continue
+        missing = sorted(known - set(node))
+        for key in node:
+            if isinstance(key, str) and key not in known:
+                close = difflib.get_close_matches(key, missing, n=1, cutoff=MISSPELT_RATIO)
+                if close:
+                    raise RecordingError(str(path), f"{section}.{key}", f"unknown key (did you mean {close[0]!r}?)")
 
 
 def read_scenario(recording: Path) -> dict:

@@ -172,6 +172,7 @@ def test_missing_and_cut_sweeps_and_bad_nmea_are_counted_warnings(bos_recording,
     ("no_manifest", "manifest.json: (file): missing"),
     ("bad_ownship", "ownship.jsonl: line 3: not valid JSON"),
     ("bad_scenario", "scenario.yaml"),
+    ("misspelt_key", "scenario.yaml: sensors.lidar.range_max_mm: unknown key (did you mean 'range_max_m'?)"),
     ("no_sensor_data", "holds no LiDAR, radar or AIS data"),
     ("pcap_garbage", "hdl32e.pcap"),
 ])
@@ -188,6 +189,10 @@ def test_unreadable_recordings_give_one_line_and_exit_2(bos_recording, tmp_path,
             (rec / "ownship.jsonl").write_text("\n".join(lines) + "\n")
         elif breakage == "bad_scenario":
             (rec / "scenario.yaml").write_text("sensors: [unclosed\n")
+        elif breakage == "misspelt_key":  # hand-edited: the TDM would run on the LiDAR's default range
+            text = (rec / "scenario.yaml").read_text()
+            assert text.count("range_max_m:") == 1
+            (rec / "scenario.yaml").write_text(text.replace("range_max_m:", "range_max_mm:"))
         elif breakage == "no_sensor_data":
             shutil.rmtree(rec / "lidar")
             shutil.rmtree(rec / "radar")
