@@ -73,11 +73,10 @@ def subset(reports: dict[str, np.ndarray], mask: np.ndarray) -> dict[str, np.nda
 
 
 def _assign(truth: TruthAtEpochs, visible: np.ndarray, rep_pos: np.ndarray, report_epoch: np.ndarray,
-            c_m: float, p: float, dont_care: np.ndarray | None, on_land: np.ndarray | None = None,
-            near: tuple[float, float] | None = None, target_id: np.ndarray | None = None) -> dict:
-    """Per epoch: the assignment, OSPA and GOSPA terms; the matched pairs (epoch, object, report, distance).
-
-    With ``target_id`` (N,): also the CLEAR MOT correspondence (:mod:`tdm.eval_identity`), ``mot_tid``
+            target_id: np.ndarray, c_m: float, p: float, dont_care: np.ndarray | None,
+            on_land: np.ndarray | None = None, near: tuple[float, float] | None = None) -> dict:
+    """Per epoch: the assignment, OSPA and GOSPA terms; the matched pairs (epoch, object, report, distance); and
+    from the reports' ``target_id`` (N,) the CLEAR MOT correspondence (:mod:`tdm.eval_identity`), ``mot_tid``
     (E, K), each object's matched target id per epoch (-1: not matched), for the id switches.
 
     A report ``on_land`` (N,) is at least the cut-off from every object: never matched nor ignored,
@@ -123,9 +122,8 @@ def _assign(truth: TruthAtEpochs, visible: np.ndarray, rep_pos: np.ndarray, repo
                 _off_land(distance_matrix(truth_pos[e, ks[close_k]], rep_pos[rows[close_r]]), land[rows[close_r]],
                           near[1]), near[1], p, GOSPA_ALPHA)["total"]
         r, cc = assign_distances(d, c_m, p)
-        if target_id is not None:
-            mr, mc = carry_forward_assignment(d, target_id[rows], last_tid[ks], c_m, p)
-            mot_tid[e, ks[mr]] = last_tid[ks[mr]] = target_id[rows[mc]]
+        mr, mc = carry_forward_assignment(d, target_id[rows], last_tid[ks], c_m, p)
+        mot_tid[e, ks[mr]] = last_tid[ks[mr]] = target_id[rows[mc]]
         pairs_e.append(np.full(r.size, e))
         pairs_k.append(ks[r])
         pairs_r.append(rows[cc])
@@ -298,8 +296,8 @@ def score(truth: TruthAtEpochs, visible: np.ndarray, reports: dict[str, np.ndarr
     E = visible.shape[0]
     rep_pos = np.stack([reports["east_m"], reports["north_m"]], axis=-1)  # (N, 2)
     on_land = reports.get("on_land")
-    a = _assign(truth, visible, rep_pos, report_epoch, c_m, p, dont_care, on_land, (lidar_range_m, NEAR_GOSPA_C_M),
-                reports["target_id"])
+    a = _assign(truth, visible, rep_pos, report_epoch, reports["target_id"], c_m, p, dont_care, on_land,
+                (lidar_range_m, NEAR_GOSPA_C_M))
     per_epoch, pd = a["per_epoch"], a["pd"]
     n_visible = int(visible.sum())
     out = {name: float(np.mean(per_epoch[key])) if E else math.nan
