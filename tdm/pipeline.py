@@ -88,6 +88,8 @@ class _Tracking:
     def __init__(self, stream: DetectionStream, config: TdmConfig):
         lidar_tcfg = _with_range(config.lidar_tracker, stream.description.lidar.range_max_m)
         radar_tcfg = _with_range(config.radar_tracker, stream.description.radar.range_m)
+        if radar_tcfg.echo_hold_beam_deg is not None and stream.description.radar.beam_az_deg:
+            radar_tcfg = replace(radar_tcfg, echo_hold_beam_deg=float(stream.description.radar.beam_az_deg))
         self.ownship = stream.ownship
         self.trackers = {"lidar": PositionTracker("lidar", lidar_tcfg), "radar": PositionTracker("radar", radar_tcfg)}
         self.ais = AisTracker(config.ais_tracker)

@@ -79,6 +79,11 @@ class TdmConfig:
         # 0.6/1.4/0.4/0.8/0.6 -> 0.2/0.2/0/0/0, id switches 1/0/0/0/3 -> 0 on every seed; the latency of weak bergs
         # upwind, which failed on every seed before, rises)
         clutter_extra_hits=1.5, clutter_plots_per_scan=0.1,
+        # a plot inside a confirmed track's echo (the beamwidth, set from the recording's radar, plus the track's half
+        # length in bearing; its half length plus 10 m in range) counts nothing towards a tentative track's
+        # confirmation: the radar cannot tell a second object there from a piece of the first's echo (docs/tdm.md,
+        # "Tracking")
+        echo_hold_beam_deg=5.2,
         # the reported covariance holds the centre's uncertainty behind the near face, 0.5 of the plots'
         # extent (busy_open_sea, seed 7, 300 s, 0.3 and 0.5 tried: NEES in its 95 % interval 0.35 -> 0.91); since
         # 2026-11-28 evening sensor_tracks.jsonl takes the face offset along the line of sight instead

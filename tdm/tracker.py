@@ -27,6 +27,7 @@ from tdm import ekf
 from tdm.association import chi2_gate, gnn, mahalanobis2
 from tdm.clutter_areas import ClutterAreas
 from tdm.detections import Detections
+from tdm.echoes import inside_echoes
 
 #: What a strong detection counts towards confirmation (:class:`TrackerConfig` ``strong_from_db``), hits.
 STRONG_HIT = 1.5
@@ -139,6 +140,15 @@ class TrackerConfig:
         fraction of the footprint's width, and the length seen before and not now) in place of
         ``extent_sigma_fraction`` of the length; the fusion's consider term keeps the length rule. None: the
         length rule.
+    echo_hold_beam_deg : float or None
+        A tentative track's detection inside the echo of a confirmed track (:func:`inside_echoes`: within this
+        beamwidth plus the confirmed track's half length, as an angle, of its bearing from the own ship, and within its
+        half length plus ``echo_hold_range_m`` of its range) counts nothing towards its confirmation: the radar cannot
+        tell a second object there from a piece of the first's echo, and pieces of a large still echo that come and
+        go from scan to scan, joined across scans, make tracks that seem to move (harbour_approach's pier and the
+        ship alongside it). A boat leaving the echo is confirmed on its hits outside it. None (default): every hit
+        counts.
+    echo_hold_range_m : float
     range_cut_sigma_m : float
         A track last updated by a detection at the sensor's range limit (:attr:`~tdm.detections.Detections.range_cut`:
         a LiDAR cluster of an object that may go on beyond it) reports this standard deviation more along the line
@@ -170,6 +180,8 @@ class TrackerConfig:
     extent_sigma_fraction: float = 0.0
     range_cut_sigma_m: float = 0.0
     footprint_width_fraction: float | None = None
+    echo_hold_beam_deg: float | None = None
+    echo_hold_range_m: float = 10.0
     process: ekf.ProcessNoise = field(default_factory=ekf.ProcessNoise)
 
 
@@ -390,6 +402,21 @@ class PositionTracker:
         if not track.confirmed and sum(track.hits) >= self._hits_to_confirm(track):
             track.confirmed = True
 
+    def _counted_hit(self, track: Track, dets: Detections, j: int) -> float:
+        """What detection ``j`` counts towards ``track``'s confirmation: its weight (:meth:`_hit_weight`), or nothing
+        for a tentative track when it lies inside another, confirmed track's echo (``echo_hold_beam_deg``)."""
+        cfg = self.config
+        if cfg.echo_hold_beam_deg is not None and not track.confirmed:
+            others = [t for t in self.tracks if t.confirmed and t is not track]
+            if others:
+                t_s = float(dets.time_s[j])
+                centre = ekf.predict_mean(np.array([t.x for t in others]), np.array([t_s - t.t_s for t in others]))
+                length = np.nan_to_num(np.array([t.length_m for t in others]), nan=0.0)
+                if np.any(inside_echoes(dets.position_m[j:j + 1], centre[:, :2], length, self._own_m,
+                                        cfg.echo_hold_beam_deg, cfg.echo_hold_range_m)):
+                    return 0.0
+        return self._hit_weight(dets, j)
+
     def _hits_to_confirm(self, track: Track) -> float:
         """``confirm_m``, plus ``clutter_extra_hits`` where the track lies in a clutter area."""
         cfg = self.config
@@ -423,7 +450,7 @@ class PositionTracker:
         if np.isfinite(dets.height_m[j]):
             track.height_m = float(dets.height_m[j]) if not np.isfinite(track.height_m) else \
                 HEIGHT_KEEP * track.height_m + HEIGHT_GAIN * float(dets.height_m[j])
-        self._record(track, self._hit_weight(dets, j))
+        self._record(track, self._counted_hit(track, dets, j))
 
     def _hit_weight(self, dets: Detections, j: int) -> float:
         """How much detection ``j`` counts towards confirmation (:class:`TrackerConfig` weak/strong)."""
@@ -472,7 +499,7 @@ class PositionTracker:
                       extent_sigma_fraction=cfg.extent_sigma_fraction, range_cut_sigma_m=cfg.range_cut_sigma_m,
                       footprint_width_fraction=cfg.footprint_width_fraction)
         _record_shape(track, dets, j)
-        self._record(track, self._hit_weight(dets, j))
+        self._record(track, self._counted_hit(track, dets, j))
         self.tracks.append(track)
 
     def _delete(self, t_s: float) -> None:

@@ -290,3 +290,33 @@ def test_a_lidar_track_reports_its_footprint_over_time():
     swollen.length_m, swollen.width_m = np.array([1000.0]), np.array([6.0])
     tracker.process(swollen, np.zeros(2))
     assert tracker.tracks[0].length_max_m == pytest.approx(180.0)
+
+
+def test_a_tentative_track_inside_a_confirmed_echo_waits_until_it_leaves_it():
+    """Pieces of a still echo joined across scans (harbour_approach's pier) do not confirm; a boat that leaves the
+    echo confirms once it is out of it."""
+    cfg = TrackerConfig(confirm_m=3, confirm_n=4, coast_s=10.0, position_floor_m2=0.0, max_range_m=1e4,
+                        init_speed_sigma_mps=4.0)
+    held = replace(cfg, echo_hold_beam_deg=5.2)
+    own = np.zeros(2)
+    pier = np.array([0.0, 500.0])  # 40 m long: its echo spans 5.2 + 2.3 deg either side and 20 + 10 m in range
+    off = 500.0 * np.array([np.sin(np.radians(4.0)), np.cos(np.radians(4.0))])  # 35 m from it: no one object
+
+    def run(config, second, scans=8):
+        tracker = PositionTracker("radar", config)
+        confirmed_at = None
+        for k in range(scans):
+            t = 2.5 * k
+            d = scan(t, [pier, second(t)] if k >= 3 else [pier])
+            d.length_m = np.array([40.0, 5.0][:len(d)])
+            tracker.process(d, own)
+            if confirmed_at is None and len(tracker.confirmed_tracks()) == 2:
+                confirmed_at = second(t)
+        return tracker, confirmed_at
+
+    assert len(run(held, lambda t: off * 1.1)[0].confirmed_tracks()) == 2  # 50 m beyond: out of the echo
+    assert len(run(cfg, lambda t: off)[0].confirmed_tracks()) == 2  # a piece inside it, no hold: confirmed
+    assert len(run(held, lambda t: off)[0].confirmed_tracks()) == 1  # held
+    # a boat leaving the echo northward at 4 m/s: confirmed once out of it, not before
+    _, confirmed_at = run(held, lambda t: off + [0.0, 4.0 * max(t - 7.5, 0.0)], scans=12)
+    assert confirmed_at is not None and np.hypot(*confirmed_at) > 500.0 + 20.0 + 10.0
