@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from tdm.ekf import wrap_pi
+
 __all__ = ["inside_echoes"]
 
 
@@ -39,6 +41,7 @@ def inside_echoes(point_m: np.ndarray, centre_m: np.ndarray, length_m: np.ndarra
     range_p, range_c = np.hypot(rel_p[:, 0], rel_p[:, 1]), np.hypot(rel_c[:, 0], rel_c[:, 1])
     bearing_p, bearing_c = np.arctan2(rel_p[:, 0], rel_p[:, 1]), np.arctan2(rel_c[:, 0], rel_c[:, 1])
     half = 0.5 * np.asarray(length_m, dtype=float)
-    d_bearing = np.abs(np.angle(np.exp(1j * (bearing_p[:, None] - bearing_c[None, :]))))
+    d_bearing = np.abs(wrap_pi(bearing_p[:, None] - bearing_c[None, :]))
     half_angle = np.radians(beam_deg) + np.arctan2(half, np.maximum(range_c, 1e-9))
-    return (d_bearing <= half_angle[None, :]) & (np.abs(range_p[:, None] - range_c[None, :]) <= (half + range_margin_m)[None, :])
+    d_range = np.abs(range_p[:, None] - range_c[None, :])
+    return (d_bearing <= half_angle[None, :]) & (d_range <= (half + range_margin_m)[None, :])
