@@ -39,6 +39,7 @@ from tdm.fusion_face import sensor_report
 from tdm.io import read_manifest, read_scenario
 from tdm.land import LandMask
 from tdm.messages import jsonl_writer, target_records
+from tdm.recording.ownship import check_covers_run
 from tdm.recording.scenario import MAX_UPDATE_RATE_HZ
 from tdm.run_config import FUSION_RULES, LIDAR_SOURCES, TdmConfig
 from tdm.scans import DetectionStream, start_time_unix_s
@@ -226,6 +227,7 @@ def run_tdm(recording: Path, out_dir: Path | None = None, config: TdmConfig | No
     stats = ReadStats()
     stream = DetectionStream(rec, config, stats, manifest=manifest, scenario=scenario)
     duration_s = float(manifest.get("duration_s") or stream.nav["t"][-1])
+    check_covers_run(stream.nav["t"], duration_s, rec)
     epochs = _EpochTimes(int(np.floor(duration_s * config.update_rate_hz + _EPOCH_COUNT_TOLERANCE)),
                          config.update_rate_hz)
     tracking = _Tracking(stream, config)

@@ -4,6 +4,10 @@ Each line (:mod:`tdm.recording.jsonl`) must hold every field of :data:`OWNSHIP_F
 JSON number (not a string, boolean or null), within :data:`BOUNDS` (``lat`` [-90, 90] and ``lon``
 [-180, 360] degrees; angles, heave and speed of a ship); ``t`` strictly increasing from line to line
 (the TDM interpolates the pose in time). The file must hold at least one sample. Errors name the line.
+
+For ``tdm run`` and ``tdm info`` the samples must also cover the run (:func:`check_covers_run`): from its start to its
+``duration_s`` within :data:`COVER_TOLERANCE_S`. A navigation log that stopped early (a logger killed, a copy cut at a
+line's end) would otherwise leave every later scan placed at the last pose, the outputs wrong without a word.
 """
 
 from __future__ import annotations
@@ -18,7 +22,7 @@ from tdm.errors import RecordingError
 from tdm.recording import values
 from tdm.recording.jsonl import read_jsonl_lines
 
-__all__ = ["read_ownship", "numeric_columns", "OWNSHIP_FIELDS"]
+__all__ = ["read_ownship", "numeric_columns", "check_covers_run", "OWNSHIP_FIELDS", "COVER_TOLERANCE_S"]
 
 OWNSHIP_FIELDS = ("t", "lat", "lon", "x", "y", "z", "heading_deg", "roll_deg", "pitch_deg", "cog_deg", "sog_mps")
 #: Bounds of the fields the TDM uses (deg, m, m/s): the format's ranges with room for other conventions.
@@ -26,6 +30,8 @@ BOUNDS = {"lat": (-90.0, 90.0), "lon": (-180.0, 360.0), "z": (-1000.0, 1000.0), 
           "roll_deg": (-180.0, 180.0), "pitch_deg": (-180.0, 180.0), "cog_deg": (-360.0, 720.0),
           "sog_mps": (-1000.0, 1000.0)}
 _MISSING = object()
+#: How far the navigation's first and last samples may lie inside the run, s: a sample interval of a 1 Hz log.
+COVER_TOLERANCE_S = 1.0
 
 
 def numeric_columns(rows: list[dict], numbers: list[int], fields: tuple[str, ...], path: Path) -> dict[str, np.ndarray]:
@@ -100,3 +106,13 @@ def read_ownship(recording: Path, stats: ReadStats | None = None) -> dict[str, n
         raise RecordingError(str(path), f"line {numbers[i]}", f"t = {columns['t'][i]:g} s is not after the "
                                                               f"previous sample's {columns['t'][i - 1]:g} s")
     return columns
+
+
+def check_covers_run(t_s: np.ndarray, duration_s: float, recording: Path) -> None:
+    """A RecordingError (place ``time``) unless the navigation times ``t_s`` (N,) s cover the run ``[0, duration_s]``
+    within :data:`COVER_TOLERANCE_S` at either end (module docstring)."""
+    first, last = float(t_s[0]), float(t_s[-1])
+    if first > COVER_TOLERANCE_S or last < float(duration_s) - COVER_TOLERANCE_S:
+        raise RecordingError(str(Path(recording) / OWNSHIP), "time",
+                             f"the navigation covers {first:g}-{last:g} s of a {float(duration_s):g} s run: "
+                             f"the scans outside it cannot be placed")

@@ -24,7 +24,7 @@ from tdm.recording.files import directory_present, is_present, regular_file
 from tdm.recording.land import read_land
 from tdm.recording.manifest import read_manifest
 from tdm.recording.npz import Unreadable
-from tdm.recording.ownship import read_ownship
+from tdm.recording.ownship import check_covers_run, read_ownship
 from tdm.recording.scenario import read_scenario
 from tdm.recording.sweep_files import list_sweeps
 from tdm.recording.sweeps import SCHEMAS, read_sweep_layout, unreadable_warning
@@ -112,6 +112,7 @@ def summarise(recording: Path) -> RecordingSummary:
     manifest = read_manifest(rec)
     scenario = read_scenario(rec)
     nav = read_ownship(rec, stats)
+    check_covers_run(nav["t"], float(manifest["duration_s"]), rec)
     summary = RecordingSummary(manifest, int(nav["t"].shape[0]), float(nav["t"][-1]))
     summary.sweep_files = _check_sweeps(rec, scenario, stats)
     pcap = rec / LIDAR_PCAP
