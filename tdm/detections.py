@@ -55,6 +55,11 @@ class Detections:
         For a radar plot, the cross-range width of its core (cells within ``core_db`` of its strongest) less
         the beam's, m (:func:`tdm.frontend.radar.radar_detections`): the size of an object the beam smears.
         None for LiDAR.
+    resolution_cells : (N,) float64 or None
+        For a radar plot, how many of the radar's resolution cells (a beamwidth by a range resolution) its cells
+        cover: ``n_cells`` times the spoke step over ``beam_az_deg`` times the sample spacing over
+        ``range_resolution_m`` (:func:`tdm.frontend.radar.radar_detections`), the independent looks at the sea a
+        clutter plot of its size holds, whatever the sweep's spokes and samples. None for LiDAR.
     range_cut : (N,) bool or None
         For a LiDAR cluster, whether its farthest point lies at the sensor's range limit (within
         :attr:`~tdm.frontend.lidar_config.LidarFrontEndConfig.range_cut_margin_m`): its object may go on beyond the
@@ -76,6 +81,7 @@ class Detections:
     strength_db: np.ndarray | None = None
     beam_fill: np.ndarray | None = None
     core_width_m: np.ndarray | None = None
+    resolution_cells: np.ndarray | None = None
     range_cut: np.ndarray | None = None
 
     def __len__(self) -> int:

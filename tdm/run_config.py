@@ -70,6 +70,13 @@ class TdmConfig:
         # plots barely over the clutter count half a hit, plots well over it 1.5 (TrackerConfig; busy_open_sea,
         # 300 s: 3.2 -> 0.8 false targets a minute, and strong new objects confirm a scan sooner)
         weak_below_db=13.0, strong_from_db=15.0,
+        # the weak limit rises 1 dB for every doubling of a plot's resolution cells beyond 8: the strongest of many
+        # clutter cells stands further out than the strongest of a few (busy_open_sea seeds 1-4, 300 s: sea clutter's
+        # 90th percentile strength 12.2 dB at 2-4 cells, 13.2 at 4-8, 14.3 at 8-16, 16.0 at 32-64); from 5 cells, where
+        # that line crosses 13 dB, it left seed 7's weakest berg unreported for 40 s (plots of 13.1-14.3 dB over 6-7
+        # cells); from 8, with the clutter-map detection, seed 3's false targets 0.6 -> 0.4 a minute and no latency
+        # changed on seeds 1-4 or 7 (1.5 and 2 dB a doubling from 8 and 10 cells did the same; TrackerConfig)
+        weak_rise_db_per_doubling=1.0, weak_rise_from_cells=8.0,
         # a plot narrower than the beam paints is a sea spike, however strong: a weak hit (Detections.beam_fill;
         # busy_open_sea seeds 7-11, 300 s: 0.6-1.0 -> 0-0.4 false targets a minute)
         min_beam_fill=0.5,

@@ -28,9 +28,8 @@ from tdm.association import chi2_gate, gnn, mahalanobis2
 from tdm.clutter_areas import ClutterAreas
 from tdm.detections import Detections
 from tdm.echoes import inside_echoes
+from tdm.tracker_config import STRONG_HIT, TrackerConfig, hit_weight
 
-#: What a strong detection counts towards confirmation (:class:`TrackerConfig` ``strong_from_db``), hits.
-STRONG_HIT = 1.5
 #: Degrees of freedom of the association gate: east and north position.
 POSITION_DOF = 2
 #: A track's second detection sets its course and speed (two-point initialisation) only when it comes
@@ -76,113 +75,6 @@ def _smoothed_size(old_m: float, new_m: float, n_updates: int) -> float:
 #: (far above the one-ulp differences of a vectorised ``np.hypot``).
 _EDGE_TOLERANCE = 1e-9
 
-
-@dataclass(frozen=True)
-class TrackerConfig:
-    """Parameters of one sensor's tracker (engineering defaults, unverified).
-
-    Attributes
-    ----------
-    gate_probability : float
-        Probability mass inside the association gate (chi-square, 2 dof).
-    confirm_m, confirm_n : int
-        Confirm a track with M hits in the last N scans that could see it.
-    coast_s : float
-        Delete a track not updated for this long, s.
-    position_floor_m2 : float
-        Smallest measurement variance per axis, m^2 (covers centroid jitter as the aspect changes).
-    cross_section_sigma_m2 : float
-        Measurement noise of the cross-section, m^2.
-    max_range_m : float
-        Tracks predicted beyond this range from the own ship are out of view: no misses counted.
-    init_speed_sigma_mps : float
-        Speed uncertainty of a new tentative track, m/s.
-    merge_distance_m : float
-        Two confirmed tracks of this sensor closer than this, or than half their summed lengths,
-        and moving alike (speeds within ``merge_speed_mps``) are one object.
-    merge_speed_mps : float
-    weak_below_db, strong_from_db : float or None
-        Hits weighted by how far the detection stands out of its background
-        (:attr:`~tdm.detections.Detections.strength_db`): one weaker than ``weak_below_db`` counts
-        ``weak_hit`` towards confirmation, one at least ``strong_from_db`` counts 1.5, the others 1.
-        Sea clutter that crosses the threshold mostly does so barely, while a target stands well
-        out (busy_open_sea, sea state 4: of the plots that pass the radar front end, clutter's have a
-        median strength of 11 dB and 92 % are under 13 dB, objects' a median of 23 dB and 92 % are
-        from 15 dB; benchmarks/results/tdm_criteria.md), so weighting the hits lets a real target
-        confirm in two scans and keeps marginal clutter from confirming in three or four. None:
-        every hit counts 1 (LiDAR).
-    weak_hit : float
-    min_beam_fill : float or None
-        A detection whose :attr:`~tdm.detections.Detections.beam_fill` is under this is narrower than an
-        echo through the antenna can be (a sea spike): it counts ``weak_hit`` whatever its strength.
-        None: not checked (LiDAR).
-    clutter_extra_hits : float
-        In a clutter area (:mod:`tdm.clutter_areas`: a cell of the polar map about the own ship where plots
-        that no track takes gather), a track needs this many hits more than ``confirm_m`` to be
-        confirmed. 0 (default): no map.
-    clutter_cell_range_m, clutter_cell_deg, clutter_memory_scans, clutter_plots_per_scan : float
-        The map's cells (depth m, width deg), its memory (scans) and the free plots a scan that make a cell
-        a clutter area (:class:`tdm.clutter_areas.ClutterAreas`).
-    max_speed_mps : float
-        A track faster than this (20 m/s = 39 kn: faster than the ships this TDM is for) is
-        deleted: it is clutter joined across scans.
-    extent_sigma_fraction : float
-        The sensor sees an extended object's near side: where its centre lies is uncertain by this
-        fraction of the track's length (its detections' smoothed extent), per axis. Added to the
-        covariance the track reports in ``sensor_tracks.jsonl``, not to the filter (the offset is a
-        slowly changing bias of the object's aspect, not noise of each detection: a "consider" term, as
-        in the Schmidt-Kalman filter) and not to what the fusion weighs and gates with: fed to the
-        fusion it widened the track-to-track gates and absorbing radii and made the fused targets worse
-        (busy_open_sea, seed 7, 300 s, radar 0.5: median error within LiDAR range 2.55 -> 3.52 m, COG
-        RMSE 5.7 -> 10.2 deg; docs/tdm.md). 0: none.
-    footprint_width_fraction : float or None
-        Report the centre's uncertainty from the footprint over time (:attr:`Track.reported_extent_var_m2`: this
-        fraction of the footprint's width, and the length seen before and not now) in place of
-        ``extent_sigma_fraction`` of the length; the fusion's consider term keeps the length rule. None: the
-        length rule.
-    echo_hold_beam_deg : float or None
-        A tentative track's detection inside the echo of a confirmed track (:func:`inside_echoes`: within this
-        beamwidth plus the confirmed track's half length, as an angle, of its bearing from the own ship, and within its
-        half length plus ``echo_hold_range_m`` of its range) counts nothing towards its confirmation: the radar cannot
-        tell a second object there from a piece of the first's echo, and pieces of a large still echo that come and
-        go from scan to scan, joined across scans, make tracks that seem to move (harbour_approach's pier and the
-        ship alongside it). A boat leaving the echo is confirmed on its hits outside it. None (default): every hit
-        counts.
-    echo_hold_range_m : float
-    range_cut_sigma_m : float
-        A track last updated by a detection at the sensor's range limit (:attr:`~tdm.detections.Detections.range_cut`:
-        a LiDAR cluster of an object that may go on beyond it) reports this standard deviation more along the line
-        of sight from the own ship, m (:func:`tdm.fusion_face.sensor_report`; a consider term as the extent's, not
-        in the filter). 0: none.
-    process : ekf.ProcessNoise
-    """
-
-    gate_probability: float = 0.999
-    confirm_m: int = 3
-    confirm_n: int = 5
-    coast_s: float = 3.0
-    position_floor_m2: float = 1.0
-    cross_section_sigma_m2: float = 50.0
-    max_range_m: float = 100.0
-    init_speed_sigma_mps: float = 8.0
-    merge_distance_m: float = 10.0
-    merge_speed_mps: float = 3.0
-    weak_below_db: float | None = None
-    strong_from_db: float | None = None
-    weak_hit: float = 0.5
-    min_beam_fill: float | None = None
-    clutter_extra_hits: float = 0.0
-    clutter_cell_range_m: float = 200.0
-    clutter_cell_deg: float = 30.0
-    clutter_memory_scans: float = 20.0
-    clutter_plots_per_scan: float = 0.1
-    max_speed_mps: float = 20.0
-    extent_sigma_fraction: float = 0.0
-    range_cut_sigma_m: float = 0.0
-    footprint_width_fraction: float | None = None
-    echo_hold_beam_deg: float | None = None
-    echo_hold_range_m: float = 10.0
-    process: ekf.ProcessNoise = field(default_factory=ekf.ProcessNoise)
 
 
 @dataclass
@@ -403,7 +295,7 @@ class PositionTracker:
             track.confirmed = True
 
     def _counted_hit(self, track: Track, dets: Detections, j: int) -> float:
-        """What detection ``j`` counts towards ``track``'s confirmation: its weight (:meth:`_hit_weight`), or nothing
+        """What detection ``j`` counts towards ``track``'s confirmation: its weight (:func:`tdm.tracker_config.hit_weight`), or nothing
         for a tentative track when it lies inside another, confirmed track's echo (``echo_hold_beam_deg``)."""
         cfg = self.config
         if cfg.echo_hold_beam_deg is not None and not track.confirmed:
@@ -415,7 +307,7 @@ class PositionTracker:
                 if np.any(inside_echoes(dets.position_m[j:j + 1], centre[:, :2], length, self._own_m,
                                         cfg.echo_hold_beam_deg, cfg.echo_hold_range_m)):
                     return 0.0
-        return self._hit_weight(dets, j)
+        return hit_weight(self.config, dets, j)
 
     def _hits_to_confirm(self, track: Track) -> float:
         """``confirm_m``, plus ``clutter_extra_hits`` where the track lies in a clutter area."""
@@ -451,20 +343,6 @@ class PositionTracker:
             track.height_m = float(dets.height_m[j]) if not np.isfinite(track.height_m) else \
                 HEIGHT_KEEP * track.height_m + HEIGHT_GAIN * float(dets.height_m[j])
         self._record(track, self._counted_hit(track, dets, j))
-
-    def _hit_weight(self, dets: Detections, j: int) -> float:
-        """How much detection ``j`` counts towards confirmation (:class:`TrackerConfig` weak/strong)."""
-        cfg = self.config
-        if cfg.min_beam_fill is not None and dets.beam_fill is not None and dets.beam_fill[j] < cfg.min_beam_fill:
-            return cfg.weak_hit
-        if dets.strength_db is None:
-            return 1.0
-        strength = float(dets.strength_db[j])
-        if cfg.strong_from_db is not None and strength >= cfg.strong_from_db:
-            return STRONG_HIT
-        if cfg.weak_below_db is not None and strength < cfg.weak_below_db:
-            return cfg.weak_hit
-        return 1.0
 
     def _two_point(self, track: Track, position_m: np.ndarray, cov_m2: np.ndarray, t_s: float) -> None:
         """Course and speed of a one-hit track from its first and this detection."""

@@ -44,7 +44,7 @@ cells), so that their per-cell arrays stay in cache; every step reads only the c
    when it lies on a spoke between two detections and every cell from one to the other has a
    level >= ``fill_level``.
 
-3b. Optional (``clutter_map_detection``, off by default; :mod:`tdm.frontend.radar_extended`): every cell whose
+3b. Clutter-map detection (``clutter_map_detection``, on by default; :mod:`tdm.frontend.radar_extended`): every cell whose
    beam-integrated power reaches its block's clutter-map seed threshold (step 5) is a detection too, so the
    interior of an echo that masked itself joins its edges.
 
@@ -493,6 +493,8 @@ def radar_detections(sweep: dict, track: OwnshipTrack, mount: Mount, config: Rad
           of the cells within ``c = core_db`` of the strongest, less the two-way beam's width ``c`` dB down, in
           quadrature; the size of an object the beam does not resolve, which ``Lc`` (taken down to the plot's
           weakest cell) loses in a saturated echo (docs/tdm.md, "Extended objects");
+        - ``resolution_cells = n_cells (360 / spokes / beam_az_deg) (dr / res)``: the plot's cells in beamwidths
+          by range resolutions;
         - ``cross_section_m2 = Lr Lc`` (the visible footprint); ``length_m`` / ``width_m`` the larger
           / smaller; ``orientation_deg`` the plot's bearing when the range extent is the longer,
           else the bearing + 90 deg, mod 180.
@@ -523,13 +525,14 @@ def radar_detections(sweep: dict, track: OwnshipTrack, mount: Mount, config: Rad
     cov = _plot_covariance(plot_range_m, u, len_r, len_c, spacing_m, config)
     compass = np.degrees(np.arctan2(u[:, 0], u[:, 1]))
     orientation = np.mod(np.where(len_r >= len_c, compass, compass + 90.0), 180.0)
+    n_cells = np.bincount(plots.label, minlength=plots.n).astype(np.int64)
     return Detections(
         sensor="radar", scan_time_s=scan_time, time_s=t_plot[k], position_m=position[k], position_cov_m2=cov[k],
         cross_section_m2=(len_r * len_c)[k], length_m=np.maximum(len_r, len_c)[k],
         width_m=np.minimum(len_r, len_c)[k], orientation_deg=orientation[k],
         height_m=np.full(int(np.count_nonzero(k)), np.nan),
-        n_cells=np.bincount(plots.label, minlength=plots.n).astype(np.int64)[k], range_m=plot_range_m[k],
-        strength_db=plots.margin_db[k], beam_fill=beam_fill[k],
+        n_cells=n_cells[k], range_m=plot_range_m[k], strength_db=plots.margin_db[k], beam_fill=beam_fill[k],
+        resolution_cells=n_cells[k] * (360.0 / n_spokes / config.beam_az_deg) * (spacing_m / config.range_resolution_m),
         core_width_m=_core_widths(plots, power, d_az, power_max, plot_range_m, n_spokes, config)[k])
 
 

@@ -54,9 +54,10 @@ class RadarFrontEndConfig:
     clutter_map_detection : bool
         Also detect every cell whose beam-integrated power reaches its block's clutter-map seed threshold
         (step 3b, :mod:`tdm.frontend.radar_extended`): the interior of an echo longer than the range CFAR's
-        window, which masks itself, so that an extended object is one plot. Default False: on the 30 held-out
-        runs 179 -> 182 cells met (5 gained, 2 lost), but on the tuning scenario's seed 3 the false targets rose
-        over the criterion (benchmarks/results/tdm_clutter_map_detection.md).
+        window, which masks itself, so that an extended object is one plot. Default True since 2026-11-29 (stop 47),
+        with the radar tracker's weak limit rising with a plot's size
+        (:attr:`tdm.tracker_config.TrackerConfig.weak_rise_db_per_doubling`), which keeps the wide sea-clutter plots
+        it makes from confirming (benchmarks/results/tdm_clutter_map_detection.md).
     video_threshold_db : float
         Power where video level 1 starts, dB over the mean thermal noise. Default 9.6 dB, the level
         noise alone crosses with probability 1e-4 (``10 log10(-ln 1e-4)``; the IMO Pfa,
@@ -174,7 +175,7 @@ class RadarFrontEndConfig:
     os_rank: int | None = None
     min_echo_level: int = 1
     fill_level: int = 1
-    clutter_map_detection: bool = False
+    clutter_map_detection: bool = True
     video_threshold_db: float = 9.6
     video_step_db: float = 3.0
     integration_spokes: int = 16

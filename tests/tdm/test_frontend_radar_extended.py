@@ -15,8 +15,8 @@ from tests.tdm.test_frontend_radar import RANGE_M, SPOKES, static_track, sweep_w
 
 #: A hull 109 m long along the beam (60 samples of 1.81 m), 500 spokes (88 deg) right of the bow, from sample 300.
 HULL_SPOKE, HULL_FIRST, HULL_SAMPLES = 500, 300, 60
-#: The front end with the clutter-map cells (off by default, RadarFrontEndConfig.clutter_map_detection).
-ON = RadarFrontEndConfig(clutter_map_detection=True)
+#: The front end with the clutter-map cells (on by default, RadarFrontEndConfig.clutter_map_detection) and without.
+ON, OFF = RadarFrontEndConfig(clutter_map_detection=True), RadarFrontEndConfig(clutter_map_detection=False)
 
 
 def _hull_sweep() -> dict[str, np.ndarray]:
@@ -35,8 +35,8 @@ def test_a_long_saturated_echo_is_one_plot_at_its_middle_with_the_clutter_map_ce
     assert len(whole) == 1
     assert _ranges(whole)[0] == pytest.approx(middle_m, abs=3.0)
     assert whole.length_m[0] == pytest.approx(RANGE_M[HULL_SAMPLES], abs=10.0)
-    edges = radar_detections(sweep, static_track(), Mount(z_m=4.0), RadarFrontEndConfig())
-    # the default, the range CFAR alone, masks the echo's interior: no plot lies within a quarter of the hull of its middle (here none
+    edges = radar_detections(sweep, static_track(), Mount(z_m=4.0), OFF)
+    # the range CFAR alone masks the echo's interior: no plot lies within a quarter of the hull of its middle (here none
     # is kept at all: the edges it passes are under the size and beam-fill tests)
     assert np.all(np.abs(_ranges(edges) - middle_m) > 0.25 * RANGE_M[HULL_SAMPLES])
 
@@ -69,3 +69,21 @@ def test_in_rain_the_clutter_map_cells_are_the_echo_over_the_rain_not_the_rain()
     det = radar_detections(sweep, static_track(), Mount(z_m=4.0), ON)
     middle_m = 0.5 * (RANGE_M[HULL_FIRST] + RANGE_M[HULL_FIRST + HULL_SAMPLES - 1])
     assert len(det) == 1 and _ranges(det)[0] == pytest.approx(middle_m, abs=3.0)
+
+
+def test_a_plot_counts_its_resolution_cells_in_beamwidths_by_range_resolutions():
+    # a point echo covers a few resolution cells (the beam's and the point-spread's smear down to its weakest cell,
+    # 3 dB a level): 1-3 at level 4, at most 8.5 saturated (level 15), where the radar tracker's weak limit starts to
+    # rise (TdmConfig.radar_tracker); the 109 m hull along the beam about 109 / 2.5 = 44 range resolutions by up to
+    # three beams (saturated, its echo smears over nearly three beamwidths down to its weakest cell)
+    def detect(sweep):
+        return radar_detections(sweep, static_track(), Mount(z_m=4.0), ON)
+
+    weak, saturated = (detect(sweep_with(points=[(HULL_SPOKE, 400, level)])) for level in (4, 15))
+    hull = detect(_hull_sweep())
+    per_cell = (360.0 / SPOKES / ON.beam_az_deg) * (float(RANGE_M[1] - RANGE_M[0]) / ON.range_resolution_m)
+    for det in (weak, saturated, hull):
+        assert det.resolution_cells == pytest.approx(det.n_cells * per_cell, rel=1e-4)
+    assert 1.0 <= weak.resolution_cells[0] <= 3.0
+    assert 3.0 < saturated.resolution_cells[0] <= 8.5
+    assert 44.0 <= hull.resolution_cells[0] <= 3.0 * 44.0
