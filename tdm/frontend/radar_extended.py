@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 from tdm.frontend.radar_cfar import _first_valid_sample, _nonzero_flat
-from tdm.frontend.radar_clutter import cell_window_power, clutter_map
+from tdm.frontend.radar_clutter import clutter_map
 from tdm.frontend.radar_config import RadarFrontEndConfig
 
 __all__ = ["clutter_map_cells"]
@@ -49,21 +49,32 @@ def clutter_map_cells(echo: np.ndarray, range_m: np.ndarray, integrated: np.ndar
     -------
     (M,) int64
         Ascending flat indices into ``echo``. A cell's power is that of the larger of its two integration
-        windows (:func:`tdm.frontend.radar_clutter.cell_window_power`), as a plot's peak's is (step 5).
+        windows (:func:`tdm.frontend.radar_clutter.cell_window_power`), as a plot's peak's is (step 5), and its
+        threshold that of the larger window's block. Worked out once per window row and sample (every spoke of
+        a group shares its windows), then read for the non-zero cells.
     """
-    n_samples = echo.shape[1]
-    flat = _nonzero_flat(echo)
+    n_spokes, n_samples = echo.shape
+    passes = _window_passes(integrated, g, config)
     first = _first_valid_sample(range_m, config.blanking_m)
-    if first > 0:
-        flat = flat[flat % n_samples >= first]
-    if flat.size == 0:
-        return flat
+    passes[:, :first] = False
+    if not passes.any():
+        return np.zeros(0, dtype=np.int64)
+    flat = _nonzero_flat(echo)
     spoke, sample = np.divmod(flat, n_samples)
-    value, row = cell_window_power(integrated, spoke, sample, g)
-    candidate = np.flatnonzero(value >= np.float32(10.0 ** (config.min_seed_db / 10.0)))
-    if candidate.size == 0:
-        return flat[:0]
-    seed = clutter_map(integrated, g, config)
+    return flat[passes.reshape(-1)[(spoke // g) * n_samples + sample]]
+
+
+def _window_passes(integrated: np.ndarray, g: int, config: RadarFrontEndConfig) -> np.ndarray:
+    """(A, N) bool: per integration row k and sample, whether a cell there reaches its seed threshold: the larger of
+    windows k - 1 (circular) and k (window k on a tie) at least ``min_seed_db`` and the clutter map's threshold of
+    that window's block (:func:`tdm.frontend.radar_clutter.clutter_map`)."""
+    a, n_samples = integrated.shape
     ba = max(1, config.clutter_block_spokes // g)
-    threshold = seed[row[candidate] // ba, sample[candidate] // config.clutter_block_samples]
-    return flat[candidate[value[candidate] >= threshold]]
+    seed = clutter_map(integrated, g, config)
+    threshold = np.repeat(np.repeat(seed, ba, axis=0)[:a], config.clutter_block_samples, axis=1)[:, :n_samples]
+    before = np.roll(integrated, 1, axis=0)
+    use_before = before > integrated
+    value = np.where(use_before, before, integrated)
+    passes = value >= np.where(use_before, np.roll(threshold, 1, axis=0), threshold)
+    passes &= value >= np.float32(10.0 ** (config.min_seed_db / 10.0))
+    return passes
