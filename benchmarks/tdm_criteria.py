@@ -241,10 +241,13 @@ def strength_lines(strengths: dict, duration_s: float) -> list[str]:
                      f"{s['from_15_db_fill_under_half']:.2f} |")
     return lines + ["", "The radar tracker counts a plot under 13 dB as half a hit and one from 15 dB as 1.5 hits",
                     "(3 needed in 4 scans): most clutter plots never add up, most object plots confirm in two scans.",
+                    "The 13 dB rises 1 dB for every doubling of a plot's resolution cells beyond 8",
+                    "(`TrackerConfig.weak_rise_db_per_doubling`: the strongest of many clutter cells stands further out).",
                     "Beam fill (`Detections.beam_fill`): a plot's azimuth extent over what the two-way beam paints",
-                    "between its strongest and weakest cells. The clutter plots that do stand out are sea spikes",
-                    "narrower than the beam; the tracker counts a plot with a fill under 0.5 as half a hit, whatever",
-                    "its strength."]
+                    "between its strongest and weakest cells. The tracker counts a plot with a fill under 0.5 as half a",
+                    "hit, whatever its strength: a sea spike narrower than the beam. With the clutter-map detection of",
+                    "extended echoes (on since 2026-11-29) a spike is mostly joined with the clutter cells about it into a",
+                    "plot that fills the beam, and is then weighed by its strength and size."]
 
 
 def report(heldout: dict, heldout_path: Path, strengths: dict, duration_s: float, quick: bool = False) -> str:
