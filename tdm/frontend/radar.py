@@ -503,8 +503,7 @@ def radar_detections(sweep: dict, track: OwnshipTrack, mount: Mount, config: Rad
           of the cells within ``c = core_db`` of the strongest, less the two-way beam's width ``c`` dB down, in
           quadrature; the size of an object the beam does not resolve, which ``Lc`` (taken down to the plot's
           weakest cell) loses in a saturated echo (docs/tdm.md, "Extended objects");
-        - ``resolution_cells = n_cells (360 / spokes / beam_az_deg) (dr / res)``: the plot's cells in beamwidths
-          by range resolutions;
+        - ``resolution_cells = n_cells (360 / spokes / beam_az_deg) (dr / res)``: its cells in beamwidths by resolutions;
         - ``cross_section_m2 = Lr Lc`` (the visible footprint); ``length_m`` / ``width_m`` the larger
           / smaller; ``orientation_deg`` the plot's bearing when the range extent is the longer,
           else the bearing + 90 deg, mod 180.
@@ -517,8 +516,7 @@ def radar_detections(sweep: dict, track: OwnshipTrack, mount: Mount, config: Rad
         ``b = bearing_sigma_beam_fraction``, ``f = extent_sigma_fraction``, ``theta3`` in radians.
     """
     echo, azimuth_deg, heading_deg, time_s, range_m = _checked_sweep(sweep, config)
-    n_spokes, n_samples = echo.shape
-    scan_time = float(time_s[0])
+    (n_spokes, n_samples), scan_time = echo.shape, float(time_s[0])
     plots = _kept_plots(echo, range_m, config, _sweep_land_blocks(land, azimuth_deg, heading_deg, time_s, range_m,
                                                                   track, mount, config))
     if plots is None:
@@ -539,8 +537,7 @@ def radar_detections(sweep: dict, track: OwnshipTrack, mount: Mount, config: Rad
     return Detections(
         sensor="radar", scan_time_s=scan_time, time_s=t_plot[k], position_m=position[k], position_cov_m2=cov[k],
         cross_section_m2=(len_r * len_c)[k], length_m=np.maximum(len_r, len_c)[k],
-        width_m=np.minimum(len_r, len_c)[k], orientation_deg=orientation[k],
-        height_m=np.full(int(np.count_nonzero(k)), np.nan),
+        width_m=np.minimum(len_r, len_c)[k], orientation_deg=orientation[k], height_m=np.full(int(np.count_nonzero(k)), np.nan),
         n_cells=n_cells[k], range_m=plot_range_m[k], strength_db=plots.margin_db[k], beam_fill=beam_fill[k],
         resolution_cells=n_cells[k] * (360.0 / n_spokes / config.beam_az_deg) * (spacing_m / config.range_resolution_m),
         core_width_m=_core_widths(plots, power, d_az, power_max, plot_range_m, n_spokes, config)[k])
