@@ -307,7 +307,7 @@ class PositionTracker:
                 if np.any(inside_echoes(dets.position_m[j:j + 1], centre[:, :2], length, self._own_m,
                                         cfg.echo_hold_beam_deg, cfg.echo_hold_range_m)):
                     return 0.0
-        return hit_weight(self.config, dets, j)
+        return hit_weight(cfg, dets, j)
 
     def _hits_to_confirm(self, track: Track) -> float:
         """``confirm_m``, plus ``clutter_extra_hits`` where the track lies in a clutter area."""

@@ -4,6 +4,7 @@ plot's size in resolution cells."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -45,9 +46,8 @@ def test_a_wide_weak_clutter_patch_does_not_confirm_where_a_small_plot_as_strong
     from tdm.tracker import PositionTracker
 
     def confirmed_after(resolution_cells, config, scans=4):
-        tracker = PositionTracker("radar", TrackerConfig(**{**config.__dict__, "confirm_m": 3, "confirm_n": 4,
-                                                            "coast_s": 10.0, "position_floor_m2": 0.0,
-                                                            "max_range_m": 1e4}))
+        tracker = PositionTracker("radar", replace(config, confirm_m=3, confirm_n=4, coast_s=10.0, position_floor_m2=0.0,
+                                                   max_range_m=1e4))
         for k in range(scans):
             d = _plot(14.0, resolution_cells)
             d.time_s = np.array([2.5 * k])
