@@ -3,7 +3,8 @@
 Roles, in Stone Soup's terms:
 
 - predictor / updater: :mod:`tdm.ekf` (thesis model, Joseph-form update);
-- hypothesiser / associator: :mod:`tdm.association` (Mahalanobis gate, GNN);
+- hypothesiser / associator: :mod:`tdm.association` (Mahalanobis gate, GNN with a miss cost of the gate,
+  confirmed tracks choosing before tentative ones);
 - initiator: an unassociated detection starts a tentative track; its second detection sets
   course and speed from the two positions (two-point initialisation);
 - confirmation: M of the last N scans that could see the track;
@@ -24,7 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tdm import ekf
-from tdm.association import chi2_gate, gnn, mahalanobis2
+from tdm.association import chi2_gate, gnn_first, mahalanobis2
 from tdm.clutter_areas import ClutterAreas
 from tdm.detections import Detections
 from tdm.echoes import inside_echoes
@@ -261,7 +262,9 @@ class PositionTracker:
             p_pos = np.array([p[:2, :2] for _, p in predicted_at(tracks, t_scan)])
             s = p_pos[:, None] + cov[None, :]
             cost = mahalanobis2(pos[None, :, :] - pred[..., :2], s)
-            pairs = gnn(cost, self._gate)
+            # confirmed tracks choose first, and a track moves off its nearest plot only where that saves more than
+            # a miss costs (tdm.association.gnn_first)
+            pairs = gnn_first(cost, self._gate, np.array([t.confirmed for t in tracks]), miss_cost=self._gate)
         assigned_tracks = {i for i, _ in pairs}
         assigned_dets = {j for _, j in pairs}
         self._own_m = np.asarray(ownship_position_m, dtype=float)[:2]

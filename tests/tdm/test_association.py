@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from tdm.association import FORBIDDEN, chi2_gate, gnn, mahalanobis2
+from tdm.association import FORBIDDEN, chi2_gate, gnn, gnn_first, mahalanobis2
 
 
 def test_chi2_gate_for_two_degrees_of_freedom_is_minus_two_log_of_the_miss():
@@ -53,3 +53,32 @@ def test_gnn_on_rectangular_and_empty_matrices():
 def test_the_gate_is_inclusive_and_forbidden_is_far_above_any_gate():
     assert gnn(np.array([[9.0]]), gate=9.0) == [(0, 0)]
     assert FORBIDDEN > chi2_gate(0.9999, 3) * 1e3
+
+
+def test_a_miss_cost_keeps_a_row_on_its_nearest_measurement():
+    # row 0 is at 0.0 from column 0 and 9.2 from column 1; row 1 gates with column 0 only (9.7). Without a miss
+    # cost the assignment pairs both rows (total 18.9); with a miss cost of the gate (13.8), row 0 keeping column 0
+    # and row 1 missing (0 + 13.8) is cheaper
+    cost = np.array([[0.0, 9.2],
+                     [9.7, 50.0]])
+    assert sorted(gnn(cost, gate=13.8)) == [(0, 1), (1, 0)]
+    assert gnn(cost, gate=13.8, miss_cost=13.8) == [(0, 0)]
+    # where moving a row saves more than a miss costs, both are paired as before
+    assert sorted(gnn(np.array([[1.0, 2.0], [2.0, 10.0]]), gate=20.0, miss_cost=20.0)) == [(0, 1), (1, 0)]
+    assert gnn(np.zeros((0, 2)), gate=9.0, miss_cost=9.0) == []
+
+
+def test_first_rows_choose_before_the_others():
+    # row 1 (a confirmed track) is nearest column 0; row 0 (tentative) gates with column 0 only. In one round the
+    # tentative row takes column 0 and pushes the confirmed row onto column 1, even with a miss cost (1.8 + 4.7 <
+    # 0 + 13.8); the confirmed row choosing first keeps column 0
+    cost = np.array([[4.7, 50.0],
+                     [0.0, 1.8]])
+    assert sorted(gnn(cost, gate=13.8, miss_cost=13.8)) == [(0, 0), (1, 1)]
+    assert gnn_first(cost, gate=13.8, first=np.array([False, True]), miss_cost=13.8) == [(1, 0)]
+    # the others choose among the columns left, their indices those of the whole matrix
+    cost = np.array([[0.5, 0.2, 50.0],
+                     [0.1, 9.0, 3.0]])
+    assert gnn_first(cost, gate=13.8, first=np.array([False, True])) == [(0, 1), (1, 0)]
+    assert gnn_first(cost, gate=13.8, first=np.array([False, False])) == gnn(cost, gate=13.8)
+    assert gnn_first(np.zeros((2, 0)), gate=1.0, first=np.array([True, False])) == []

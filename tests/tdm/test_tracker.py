@@ -320,3 +320,26 @@ def test_a_tentative_track_inside_a_confirmed_echo_waits_until_it_leaves_it():
     # a boat leaving the echo northward at 4 m/s: confirmed once out of it, not before
     _, confirmed_at = run(held, lambda t: off + [0.0, 4.0 * max(t - 7.5, 0.0)], scans=12)
     assert confirmed_at is not None and np.hypot(*confirmed_at) > 500.0 + 20.0 + 10.0
+
+
+def _plots(t, positions, sigmas):
+    d = scan(t, positions)
+    d.position_cov_m2 = np.array([np.eye(2) * s**2 for s in sigmas])
+    return d
+
+
+def test_a_one_hit_track_beside_a_hull_does_not_push_its_confirmed_track_off_it():
+    # a still hull painted as one wide plot (25 m standard deviation) and confirmed; a one-hit track starts on a
+    # small plot 55 m south of it; next scan a small plot shows 35 m east of the hull. The tentative track gates
+    # with the hull's plot only, so one assignment over all tracks (which pairs as many as it can) gives it the
+    # hull's plot and moves the hull's track onto the small plot (harbour_approach seed 34's anchored tanker); the
+    # confirmed track choosing first keeps the hull's plot
+    tracker = PositionTracker("radar", CFG)
+    for k in range(4):
+        tracker.process(_plots(float(k), [[0.0, 0.0]], [25.0]), np.zeros(2))
+    (hull,) = tracker.confirmed_tracks()
+    tracker.process(_plots(4.0, [[0.0, 0.0], [-12.0, -54.0]], [25.0, 5.0]), np.zeros(2))
+    assert len(tracker.tracks) == 2
+    tracker.process(_plots(5.0, [[0.0, 0.0], [35.0, 0.0]], [25.0, 5.0]), np.zeros(2))
+    assert np.hypot(*hull.x[:2]) < 5.0
+    assert hull.updated_s == 5.0
