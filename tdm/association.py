@@ -55,17 +55,26 @@ def gnn(cost: np.ndarray, gate: float, miss_cost: float | None = None) -> list[t
         assignment pairs as many rows as the gate allows, then minimises the cost, and a row that gates with one
         measurement only takes it from a row that had a nearer choice.
     """
-    if cost.size == 0:
-        return []
-    masked = np.where(cost <= gate, cost, FORBIDDEN)
-    n_rows, n_cols = masked.shape
+    rows, cols = _assigned(cost, gate, miss_cost)
+    return list(zip(rows.tolist(), cols.tolist()))
+
+
+def _assigned(cost: np.ndarray, gate: float, miss_cost: float | None) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`gnn`'s pairs as two (P,) int arrays, rows and columns, by row."""
+    admissible = cost <= gate
     if miss_cost is not None:
-        missed = np.full((n_rows, n_rows), FORBIDDEN)
-        np.fill_diagonal(missed, miss_cost)
-        masked = np.hstack([masked, missed])
+        admissible &= cost < miss_cost
+    if not admissible.any():
+        return np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.intp)
+    if miss_cost is None:
+        masked = np.where(admissible, cost, FORBIDDEN)
+    else:
+        # the costs less the miss cost (so a row left out adds nothing), a pair that saves nothing set to 0: the same
+        # optimum as a miss column per row, on a (T, D) matrix (a 0 pair is one left out)
+        masked = np.where(admissible, cost - miss_cost, 0.0)
     rows, cols = linear_sum_assignment(masked)
-    keep = (cols < n_cols) & (masked[rows, cols] < FORBIDDEN)
-    return list(zip(rows[keep].tolist(), cols[keep].tolist()))
+    keep = admissible[rows, cols]
+    return rows[keep], cols[keep]
 
 
 def gnn_first(cost: np.ndarray, gate: float, first: np.ndarray, miss_cost: float | None = None
@@ -77,7 +86,7 @@ def gnn_first(cost: np.ndarray, gate: float, first: np.ndarray, miss_cost: float
     tentative track that gates with one plot only can take it from the confirmed track it belongs to and push that
     track onto a plot further off (harbour_approach seed 34: one-hit tracks of the anchored tanker's sidelobe
     spots took its hull's plot twice, and its confirmed track was moved 35 m, then 59 m onto weak plots beside it,
-    and turned into a 8 m/s track circling in place). A confirmed track's association is not bent by tracks that
+    and turned into an 8 m/s track circling in place). A confirmed track's association is not bent by tracks that
     may be clutter.
 
     Parameters
@@ -97,8 +106,13 @@ def gnn_first(cost: np.ndarray, gate: float, first: np.ndarray, miss_cost: float
         (row, column) pairs, by row.
     """
     first = np.asarray(first, dtype=bool)
-    rows_a, rows_b = np.nonzero(first)[0], np.nonzero(~first)[0]
-    pairs = [(int(rows_a[i]), j) for i, j in gnn(cost[rows_a], gate, miss_cost)]
-    free = np.setdiff1d(np.arange(cost.shape[1]), [j for _, j in pairs])
-    pairs += [(int(rows_b[i]), int(free[j])) for i, j in gnn(cost[np.ix_(rows_b, free)], gate, miss_cost)]
-    return sorted(pairs)
+    rows_a, rows_b = np.flatnonzero(first), np.flatnonzero(~first)
+    ia, ja = _assigned(cost[rows_a], gate, miss_cost)
+    free = np.ones(cost.shape[1], dtype=bool)
+    free[ja] = False
+    free_cols = np.flatnonzero(free)
+    ib, jb = _assigned(cost[rows_b][:, free_cols], gate, miss_cost)
+    rows = np.concatenate([rows_a[ia], rows_b[ib]])
+    cols = np.concatenate([ja, free_cols[jb]])
+    order = np.argsort(rows, kind="stable")
+    return list(zip(rows[order].tolist(), cols[order].tolist()))
