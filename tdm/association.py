@@ -84,10 +84,10 @@ def gnn_first(cost: np.ndarray, gate: float, first: np.ndarray, miss_cost: float
 
     One optimal assignment over all rows maximises the number of gated pairs before it minimises their cost, so a
     tentative track that gates with one plot only can take it from the confirmed track it belongs to and push that
-    track onto a plot further off (harbour_approach seed 34: one-hit tracks of the anchored tanker's sidelobe
-    spots took its hull's plot twice, and its confirmed track was moved 35 m, then 59 m onto weak plots beside it,
-    and turned into an 8 m/s track circling in place). A confirmed track's association is not bent by tracks that
-    may be clutter.
+    track onto a plot further off (harbour_approach seed 34: one-hit tracks of spots beside the anchored tanker took
+    its hull's plot twice, and its confirmed track was moved 35 m, then 59 m, onto small plots beside it and turned
+    into an 8 m/s track circling in place). A confirmed track's association is not bent by tracks that may be
+    clutter.
 
     Parameters
     ----------
