@@ -298,8 +298,9 @@ class PositionTracker:
             track.confirmed = True
 
     def _counted_hit(self, track: Track, dets: Detections, j: int) -> float:
-        """What detection ``j`` counts towards ``track``'s confirmation: its weight (:func:`tdm.tracker_config.hit_weight`), or nothing
-        for a tentative track when it lies inside another, confirmed track's echo (``echo_hold_beam_deg``)."""
+        """What detection ``j`` counts towards ``track``'s confirmation: its weight
+        (:func:`tdm.tracker_config.hit_weight`), or nothing for a tentative track when it lies inside another,
+        confirmed track's echo (``echo_hold_beam_deg``)."""
         cfg = self.config
         if cfg.echo_hold_beam_deg is not None and not track.confirmed:
             others = [t for t in self.tracks if t.confirmed and t is not track]

@@ -54,8 +54,9 @@ class TrackerConfig:
         (:attr:`~tdm.detections.Detections.resolution_cells`) rises by ``weak_rise_db_per_doubling`` for every
         doubling of its cells: the highest of many independent clutter cells stands further out of the clutter
         level than the highest of a few (the largest of N draws), so a wide patch of sea clutter, which the
-        clutter-map detection of extended echoes (:attr:`~tdm.frontend.radar_config.RadarFrontEndConfig.clutter_map_detection`)
-        joins into one plot, reaches 13-16 dB where a few cells of it reach 11-12. Fitted on busy_open_sea seeds 1-4
+        clutter-map detection of extended echoes
+        (:attr:`~tdm.frontend.radar_config.RadarFrontEndConfig.clutter_map_detection`) joins into one plot, reaches
+        13-16 dB where a few cells of it reach 11-12. Fitted on busy_open_sea seeds 1-4
         (300 s, plots of beam fill 0.5 or more at least 60 m outside every object): the 90th percentile of sea
         clutter's strength rises about 1 dB a doubling, 12.2 dB at 2-4 cells, 13.2 at 4-8, 14.3 at 8-16, 16.0 at
         32-64, and crosses ``weak_below_db`` (13 dB) at about 5 cells. The radar tracker's limit rises at that

@@ -503,7 +503,7 @@ def radar_detections(sweep: dict, track: OwnshipTrack, mount: Mount, config: Rad
           of the cells within ``c = core_db`` of the strongest, less the two-way beam's width ``c`` dB down, in
           quadrature; the size of an object the beam does not resolve, which ``Lc`` (taken down to the plot's
           weakest cell) loses in a saturated echo (docs/tdm.md, "Extended objects");
-        - ``resolution_cells = n_cells (360 / spokes / beam_az_deg) (dr / res)``: its cells in beamwidths by resolutions;
+        - ``resolution_cells = n_cells (360 / spokes / beam_az_deg) (dr / res)``: cells in beamwidths x resolutions;
         - ``cross_section_m2 = Lr Lc`` (the visible footprint); ``length_m`` / ``width_m`` the larger
           / smaller; ``orientation_deg`` the plot's bearing when the range extent is the longer,
           else the bearing + 90 deg, mod 180.
@@ -531,16 +531,30 @@ def radar_detections(sweep: dict, track: OwnshipTrack, mount: Mount, config: Rad
                                           mount)
     k = _off_ship(bearing_rel_deg, plot_range_m, mount, config)
     cov = _plot_covariance(plot_range_m, u, len_r, len_c, spacing_m, config)
-    compass = np.degrees(np.arctan2(u[:, 0], u[:, 1]))
-    orientation = np.mod(np.where(len_r >= len_c, compass, compass + 90.0), 180.0)
+    orientation = _orientation_deg(u, len_r, len_c)
     n_cells = np.bincount(plots.label, minlength=plots.n).astype(np.int64)
     return Detections(
         sensor="radar", scan_time_s=scan_time, time_s=t_plot[k], position_m=position[k], position_cov_m2=cov[k],
         cross_section_m2=(len_r * len_c)[k], length_m=np.maximum(len_r, len_c)[k],
-        width_m=np.minimum(len_r, len_c)[k], orientation_deg=orientation[k], height_m=np.full(int(np.count_nonzero(k)), np.nan),
-        n_cells=n_cells[k], range_m=plot_range_m[k], strength_db=plots.margin_db[k], beam_fill=beam_fill[k],
-        resolution_cells=n_cells[k] * (360.0 / n_spokes / config.beam_az_deg) * (spacing_m / config.range_resolution_m),
+        width_m=np.minimum(len_r, len_c)[k], orientation_deg=orientation[k],
+        height_m=np.full(int(np.count_nonzero(k)), np.nan), n_cells=n_cells[k], range_m=plot_range_m[k],
+        strength_db=plots.margin_db[k], beam_fill=beam_fill[k],
+        resolution_cells=_resolution_cells(n_cells[k], n_spokes, spacing_m, config),
         core_width_m=_core_widths(plots, power, d_az, power_max, plot_range_m, n_spokes, config)[k])
+
+
+def _orientation_deg(u: np.ndarray, len_r: np.ndarray, len_c: np.ndarray) -> np.ndarray:
+    """(P,) plots' orientation, deg in [0, 180): the bearing of the line of sight ``u`` (P, 2) (east, north) where the
+    range extent ``len_r`` (P,) is the longer, else that bearing + 90 deg (``len_c`` (P,) the cross-range extent)."""
+    compass = np.degrees(np.arctan2(u[:, 0], u[:, 1]))
+    return np.mod(np.where(len_r >= len_c, compass, compass + 90.0), 180.0)
+
+
+def _resolution_cells(n_cells: np.ndarray, n_spokes: int, spacing_m: float, config: RadarFrontEndConfig
+                      ) -> np.ndarray:
+    """(P,) how many of the radar's resolution cells (a beamwidth by a range resolution) plots of ``n_cells`` (P,)
+    sweep cells cover: ``n_cells (360 / n_spokes / beam_az_deg) (spacing_m / range_resolution_m)``."""
+    return n_cells * (360.0 / n_spokes / config.beam_az_deg) * (spacing_m / config.range_resolution_m)
 
 
 def _sweep_land_blocks(land: LandMask | None, azimuth_deg: np.ndarray, heading_deg: np.ndarray, time_s: np.ndarray,
