@@ -147,6 +147,16 @@ class _Tracking:
             write_track(record)
 
 
+def _check_rendered_scans(rec: Path, manifest: dict, scanned: tuple[str, ...]) -> None:
+    """An error where the manifest lists the LiDAR or the radar as rendered and the recording holds none of its scans
+    (a partial copy: the run would go on without that sensor and say nothing)."""
+    for sensor in ("lidar", "radar"):
+        if sensor in (manifest.get("sensors_rendered") or []) and sensor not in scanned:
+            also = " and no lidar/hdl32e.pcap" if sensor == "lidar" else ""
+            raise RecordingError(str(rec / sensor / "sweeps"), "(directory)",
+                                 f"missing{also}, though manifest.json lists {sensor} as rendered (a partial copy?)")
+
+
 def _checked_config(rec: Path, config: TdmConfig | None) -> TdmConfig:
     """``config``, or the recording's (:meth:`TdmConfig.for_recording`), with its output rate checked."""
     config = config if config is not None else TdmConfig.for_recording(rec)
@@ -226,6 +236,7 @@ def run_tdm(recording: Path, out_dir: Path | None = None, config: TdmConfig | No
     out = Path(out_dir) if out_dir is not None else rec / "tdm"
     stats = ReadStats()
     stream = DetectionStream(rec, config, stats, manifest=manifest, scenario=scenario)
+    _check_rendered_scans(rec, manifest, stream.scanned_sensors)
     duration_s = float(manifest.get("duration_s") or stream.nav["t"][-1])
     check_covers_run(stream.nav["t"], duration_s, rec)
     epochs = _EpochTimes(int(np.floor(duration_s * config.update_rate_hz + _EPOCH_COUNT_TOLERANCE)),

@@ -154,6 +154,11 @@ class DetectionStream:
         if not self._jobs and not has_ais:
             raise RecordingError(str(rec), "(directory)", "holds no LiDAR, radar or AIS data to detect targets in")
 
+    @property
+    def scanned_sensors(self) -> tuple[str, ...]:
+        """The sensors whose scans the stream reads (``lidar``, ``radar``), in its order."""
+        return tuple(self._jobs)
+
     def follow(self, jobs: Jobs, ownship: OwnshipTrack | None = None) -> None:
         """Take the scans from ``jobs`` instead of the recording's files (live mode: scans that arrive while
         the stream runs; per sensor an iterator of ``(sensor, sweep path)`` in time order and the scan period, s),
