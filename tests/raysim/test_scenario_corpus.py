@@ -10,7 +10,6 @@ from __future__ import annotations
 import datetime as dt
 import json
 import re
-import time
 from pathlib import Path
 
 import pytest
@@ -24,8 +23,10 @@ from raysim.yaml_loader import parse_yaml
 from tests.conftest import REPO
 from tests.raysim.corpus import make_scenarios as corpus
 
-#: Longest a case may take, s (most take a few milliseconds; the million aliases about 0.1 s).
-CASE_SECONDS = 3.0
+#: Cases refused at a bound of the YAML reader: the line named must lie in the first part of the file, proof that
+#: reading stopped at the bound instead of composing (or expanding) the whole document first. (A wall-clock bound
+#: stood here and failed CI on a slow machine, 3.2 s against 3.0 s: speed belongs in benchmarks/, not in tests.)
+STOPPED_BEFORE_FRACTION = 0.8
 
 
 def _tree(folder: Path) -> dict[str, int]:
@@ -33,12 +34,20 @@ def _tree(folder: Path) -> dict[str, int]:
     return {str(p.relative_to(folder)): p.lstat().st_size for p in folder.rglob("*")}
 
 
-def _run(scenario: Path, out: Path, capsys) -> tuple[int, str, str, float]:
-    started = time.perf_counter()
+def _run(scenario: Path, out: Path, capsys) -> tuple[int, str, str]:
     code = main(["render", str(scenario), "-o", str(out), "--duration", "1", "--no-progress"])
-    elapsed = time.perf_counter() - started
     captured = capsys.readouterr()
-    return code, captured.out, captured.err, elapsed
+    return code, captured.out, captured.err
+
+
+def _stopped_early(case, scenario: Path, stderr: str) -> None:
+    """Assert a case refused at a YAML bound names a line well before the file's end."""
+    if not (case.place == "line #" and case.what.startswith("more than")):
+        return
+    line = int(re.search(r": line (\d+)", stderr).group(1))
+    with open(scenario, "rb") as handle:
+        n_lines = sum(1 for _ in handle)
+    assert line < STOPPED_BEFORE_FRACTION * n_lines, f"{case.name}: refused at line {line} of {n_lines}"
 
 
 def test_corpus_is_large_and_indexed():
@@ -71,7 +80,7 @@ def test_case_is_one_line_exit_2_nothing_written(case, tmp_path, capsys):
         scenario = folder / f"{case.name}.yaml"
     before = _tree(folder)
     out = tmp_path / "out"
-    code, stdout, stderr, elapsed = _run(scenario, out, capsys)
+    code, stdout, stderr = _run(scenario, out, capsys)
     file, place, what = corpus.expected_line(case, folder, scenario)
     pattern = re.escape(f"error: {file}: ") + re.escape(place).replace("\\#", "#").replace("#", r"\d+") \
         + re.escape(f": {what}")
@@ -82,7 +91,7 @@ def test_case_is_one_line_exit_2_nothing_written(case, tmp_path, capsys):
     assert not out.exists()
     assert sorted(p.name for p in tmp_path.iterdir()) == (["in"] if case.generated else [])  # no staging left
     assert _tree(folder) == before  # nothing written next to the scenario
-    assert elapsed < CASE_SECONDS, f"{case.name} took {elapsed:.1f} s"
+    _stopped_early(case, scenario, stderr)
 
 
 def test_a_duration_from_the_command_line_is_held_to_the_time_limits(tmp_path, capsys):

@@ -113,9 +113,9 @@ def test_position_packets_arrive_once_a_second_with_a_gprmc(session):
     times = np.asarray(rx["lidar_position"].times)
     gaps = np.diff(times)
     assert np.median(np.abs(gaps - 1.0)) < 0.01
-    # on an absolute schedule: a stall of the VM delays one packet (up to 0.2 s: one in about five runs on this
-    # 2-core VM under load, 0.137 s once) without shifting the next, so the span stays (n - 1) s
-    assert np.all(np.abs(gaps - 1.0) < 0.2)
+    # on an absolute schedule: a stall of the VM delays one packet (0.137 s once on this 2-core VM under load; a
+    # slower machine stalls longer, so the bound is wide) without shifting the next, so the span stays (n - 1) s
+    assert np.all(np.abs(gaps - 1.0) < 0.5)
     assert times[-1] - times[0] == pytest.approx(gaps.size, abs=0.05)
 
 
