@@ -125,6 +125,7 @@ class Fuser:
         self.beams_by_mmsi: dict[int, float] = {}
         self._ended: list[FusedTarget] = []
         self._folded: dict[tuple[str, int], FusedTarget] = {}  # track -> the target it held before a merge
+        self._inside_at_s: dict[tuple[str, int], float] = {}  # absorbed track -> its last plot's time while inside
         self._ids = itertools.count(1)
         self._gate = chi2_gate(config.gate_probability, POSITION_DOF)
         self._moving_since: dict[int, float] = {}
@@ -157,6 +158,7 @@ class Fuser:
         live = {(s, tr.track_id): tr for s, trs in tracks_by_sensor.items() for tr in trs}
         states = dict(zip(live, predicted_at(list(live.values()), t_s)))  # at once; kept for the output
         self._folded = {k: t for k, t in self._folded.items() if k in live}
+        self._inside_at_s = {k: t for k, t in self._inside_at_s.items() if k in live}
         moved = set()
         if own_position_m is not None and cfg.radar_hidden_depth_fraction > 0.0:
             moved = behind_the_face(self.targets, states, live, own_position_m, cfg)
@@ -177,7 +179,7 @@ class Fuser:
             x, _ = self._estimate(target, states)
             half = self._half_length(target, live)
             target.absorbed = {k for k in target.absorbed if k in live and k not in claimed
-                               and self._inside(states[k], x, half)}
+                               and self._stays_absorbed(k, live[k], states[k], x, half)}
             self._promote(target, states, live, t_s)
             claimed.update(target.absorbed)
             claimed.update(target.members.items())
@@ -242,10 +244,21 @@ class Fuser:
                 host.members[sensor] = tr.track_id
         elif host is not None:
             host.absorbed.add(key)
+            self._inside_at_s[key] = tr.updated_s
         if host is None:
             self.targets.append(self._unfold(key) or self._revive(states[key], t_s)
                                 or FusedTarget(next(self._ids), created_s=t_s))
             self.targets[-1].members = {sensor: tr.track_id}
+
+    def _stays_absorbed(self, key: tuple[str, int], tr: Track, state: tuple, centre: np.ndarray,
+                        half_length_m: float) -> bool:
+        """Whether absorbed track ``key`` stays with its target (``centre`` (6,), radius ``half_length_m``, m): while
+        its ``state`` lies inside the footprint, and (``release_absorbed_on_plot``) while it has had no plot since it
+        last did: a coasting track moves on its own velocity, not on evidence that it is another object."""
+        if self._inside(state, centre, half_length_m):
+            self._inside_at_s[key] = tr.updated_s
+            return True
+        return self.config.release_absorbed_on_plot and tr.updated_s <= self._inside_at_s.get(key, -math.inf)
 
     def _unfold(self, key: tuple[str, int]) -> FusedTarget | None:
         """The target that track ``key`` held before it was folded into another (:meth:`_merge_overlapping`), when

@@ -115,6 +115,12 @@ class FusionConfig:
     # rough_sea_rain's 90 m crossing cargo at 1.2-1.5 km, radar-only targets 120-160 m from its centre at its
     # range and speed) rather than the larger of the two
     radar_smear_beyond_size: bool = True
+    # an absorbed track leaves its target only on a plot outside the target's footprint: one that has had no plot since
+    # it last lay inside (coasting on its own velocity while the target moves on) stays absorbed (busy_open_sea seed 3,
+    # tuning: a track of weak echo pieces beside the moving research ship, last updated 88 m off the ship's track,
+    # coasted out of the footprint and was reported for 5 s as a target of its own); False: it leaves as soon as its
+    # predicted position lies outside
+    release_absorbed_on_plot: bool = True
     # report a target without AIS that has absorbed tracks of these sensors at the mean of its member's and those
     # tracks' positions, their scatter in its covariance (tdm.fusion_weights.with_fragments): a large object's
     # centre lies among the parts its plots fall on

@@ -146,3 +146,22 @@ def test_a_slow_target_that_ended_before_settling_is_looked_for_where_it_was(slo
     moving.step(5.0, {})
     where = make_track(2, "radar", 0.0, 400.0, t=65.0)  # where it was: a moving target is not looked for there
     assert moving.step(65.0, {"radar": [where]})[0].target.target_id != gone.target.target_id
+
+
+@pytest.mark.parametrize("on_plot", [True, False])
+def test_an_absorbed_track_leaves_its_target_only_on_a_plot_outside_it(on_plot):
+    """busy_open_sea seed 3: a track of weak echo pieces beside the moving research ship, absorbed by the ship's
+    target, coasted out of its footprint as the ship moved on and was reported as a target of its own. It stays
+    absorbed while it has no plot since it last lay inside; a plot outside the footprint releases it."""
+    fuser = Fuser(FusionConfig(release_absorbed_on_plot=on_plot))
+    host = make_track(1, "radar", 0.0, 600.0, var=4.0, t=1.0)
+    host.length_m = 40.0  # absorbing radius 30 m
+    piece = make_track(2, "radar", 10.0, 600.0, var=4.0, t=2.0)
+    fuser.step(1.0, {"radar": [host]})
+    assert len(fuser.step(2.0, {"radar": [host, piece]})) == 1  # inside the footprint: absorbed
+    host.x[0], host.t_s, host.updated_s = 200.0, 4.0, 4.0  # the host moves on; the piece coasts, no plot since
+    assert len(fuser.step(4.0, {"radar": [host, piece]})) == (1 if on_plot else 2)
+    piece.t_s = piece.updated_s = 5.0  # a plot where it is, 190 m from the host: released
+    host.t_s = host.updated_s = 5.0
+    out = fuser.step(5.0, {"radar": [host, piece]})
+    assert len(out) == 2 and sorted(e.sources for e in out) == [["radar"], ["radar"]]
