@@ -14,7 +14,8 @@
   known from AIS static data or from its tracks' measured extents, plus three standard
   deviations: the radar beam smears a ship's ends by tens of metres at range; for a radar track, plus half
   the beam's cross-range resolution at its range) is absorbed:
-  it belongs to that target, is not reported and does not enter the fusion. An AIS track is never
+  it belongs to that target, is not reported and does not enter the fusion; it leaves only on a plot outside the
+  footprint, not by coasting out of it (``release_absorbed_on_plot``). An AIS track is never
   absorbed (it is a ship's identity): inside the footprint of a target without AIS (by the ship's own
   length when known, plus three standard deviations of both positions) whose velocity is not known to
   differ from the ship's it joins that target; otherwise it starts its own. An AIS ship's absorbed LiDAR
