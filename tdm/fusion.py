@@ -37,14 +37,8 @@
 - **Covariance intersection** (``fusion: ci``), the consistent alternative, with the fast
   weights ``w_i = (1/tr P_i) / sum_j (1/tr P_j)`` (Niehsen 2002):
   ``P^-1 = sum_i w_i P_i^-1``, ``x = P sum_i w_i P_i^-1 x_i``.
-- **Classes.** ``vessel``: it has an AIS track, or it has moved at over ``vessel_speed_mps``
-  with confidence (by two standard deviations, for 5 s); stationary: speed under half of
-  ``vessel_speed_mps`` with a standard deviation under it (two sigmas were too strict: radar
-  tracks of still bergs keep about 0.5 m/s of speed uncertainty); ``iceberg``: stationary for
-  ``settle_s`` with a footprint over
-  ``iceberg_area_m2`` or a LiDAR height over ``iceberg_height_m``; ``fixed obstacle``: stationary
-  and smaller; else ``unknown``. A class once given to a target is kept unless a vessel
-  is seen.
+- **Classes** (:mod:`tdm.fusion_classes`): ``vessel``, ``iceberg``, ``fixed obstacle`` or ``unknown``, from the
+  target's AIS, its fused speed over time, its footprint and its LiDAR height.
 """
 
 from __future__ import annotations
@@ -57,6 +51,7 @@ import numpy as np
 
 from tdm import ekf
 from tdm.association import chi2_gate, gnn, mahalanobis2
+from tdm.fusion_classes import STILL_SPEED_FRACTION, VESSEL_SIGMAS, Classifier
 from tdm.fusion_config import FusionConfig
 from tdm.fusion_geometry import _EIGEN_TOLERANCE, FOOTPRINT_SIGMAS, MERGE_SIGMAS, MERGE_SPEED_MPS  # noqa: F401
 from tdm.fusion_geometry import clearly_apart as _clearly_apart
@@ -72,12 +67,6 @@ from tdm.tracker import Track, predicted_at
 
 #: Degrees of freedom of the track-to-track gate: east and north position.
 POSITION_DOF = 2
-#: A target is a vessel once it has moved (faster than ``vessel_speed_mps`` by VESSEL_SIGMAS standard
-#: deviations of its speed) for this long, s.
-VESSEL_MOVING_S = 5.0
-VESSEL_SIGMAS = 2
-#: A target is still while its speed is under this fraction of ``vessel_speed_mps``.
-STILL_SPEED_FRACTION = 0.5
 #: A member leaves its target when its statistic exceeds this many gates, or its distance this many
 #: ``max_distance_m``: looser than joining, so that a track does not flicker in and out.
 RELEASE_GATES = 4
@@ -129,8 +118,7 @@ class Fuser:
         self._inside_at_s: dict[tuple[str, int], float] = {}  # absorbed track -> its last plot's time while inside
         self._ids = itertools.count(1)
         self._gate = chi2_gate(config.gate_probability, POSITION_DOF)
-        self._moving_since: dict[int, float] = {}
-        self._still_since: dict[int, float] = {}
+        self._classifier = Classifier(config)
         self._memo: dict | None = None  # the fused estimates of one step (_estimate)
 
     def step(self, t_s: float, tracks_by_sensor: dict[str, list[Track]],
@@ -223,7 +211,7 @@ class Fuser:
             ais_track = live.get(("ais", target.members.get("ais", -1)))
             target.mmsi = ais_track.mmsi if ais_track is not None else target.mmsi
             heights = [live[(s, i)].height_m for s, i in target.members.items() if s == "lidar"]
-            self._classify(target, x, p, t_s, heights[0] if heights else float("nan"))
+            self._classifier.classify(target, x, p, t_s, heights[0] if heights else float("nan"))
             out.append(FusedEstimate(target, x, reported_p, sorted(target.members)))
         return out
 
@@ -575,26 +563,3 @@ class Fuser:
             if math.isfinite(widening_m):  # a broken covariance does not hold a member for ever
                 limit_m += widening_m
         return mahalanobis2(d, s) > RELEASE_GATES * self._gate or np.hypot(*d) > limit_m
-
-    def _classify(self, target: FusedTarget, x: np.ndarray, p: np.ndarray, t_s: float, height_m: float) -> None:
-        cfg = self.config
-        if "ais" in target.members:
-            target.descriptor = "vessel"
-            return
-        speed, sigma = x[ekf.U], np.sqrt(max(p[ekf.U, ekf.U], 0.0))
-        tid = target.target_id
-        if speed - VESSEL_SIGMAS * sigma > cfg.vessel_speed_mps:
-            self._moving_since.setdefault(tid, t_s)
-            if t_s - self._moving_since[tid] >= VESSEL_MOVING_S:
-                target.descriptor = "vessel"
-        else:
-            self._moving_since.pop(tid, None)
-        if target.descriptor == "vessel":
-            return
-        if abs(speed) < STILL_SPEED_FRACTION * cfg.vessel_speed_mps and sigma < cfg.vessel_speed_mps:
-            self._still_since.setdefault(tid, t_s)
-            if t_s - self._still_since[tid] >= cfg.settle_s:
-                big = x[ekf.ALPHA] >= cfg.iceberg_area_m2 or (np.isfinite(height_m) and height_m >= cfg.iceberg_height_m)
-                target.descriptor = "iceberg" if big else "fixed obstacle"
-        else:
-            self._still_since.pop(tid, None)
