@@ -147,14 +147,23 @@ class _Tracking:
             write_track(record)
 
 
-def _check_rendered_scans(rec: Path, manifest: dict, scanned: tuple[str, ...]) -> None:
+def _check_rendered_scans(rec: Path, manifest: dict, scanned: tuple[str, ...], sweep_files: dict[str, int]) -> None:
     """An error where the manifest lists the LiDAR or the radar as rendered and the recording holds none of its scans
-    (a partial copy: the run would go on without that sensor and say nothing)."""
+    (a partial copy: the run would go on without that sensor and say nothing): no sweeps directory (nor, for the
+    LiDAR, a PCAP), or one that holds no sweep file where manifest.json counts some (a run shorter than a radar
+    revolution has none, rightly)."""
+    counts = manifest.get("counts") if isinstance(manifest.get("counts"), dict) else {}
     for sensor in ("lidar", "radar"):
-        if sensor in (manifest.get("sensors_rendered") or []) and sensor not in scanned:
+        if sensor not in (manifest.get("sensors_rendered") or []):
+            continue
+        if sensor not in scanned:
             also = " and no lidar/hdl32e.pcap" if sensor == "lidar" else ""
             raise RecordingError(str(rec / sensor / "sweeps"), "(directory)",
                                  f"missing{also}, though manifest.json lists {sensor} as rendered (a partial copy?)")
+        expected = counts.get(f"{sensor}/sweeps")
+        if sweep_files.get(sensor) == 0 and isinstance(expected, int) and expected > 0:
+            raise RecordingError(str(rec / sensor / "sweeps"), "(directory)",
+                                 f"holds none of the {expected} sweep files manifest.json counts (a partial copy?)")
 
 
 def _checked_config(rec: Path, config: TdmConfig | None) -> TdmConfig:
@@ -236,7 +245,7 @@ def run_tdm(recording: Path, out_dir: Path | None = None, config: TdmConfig | No
     out = Path(out_dir) if out_dir is not None else rec / "tdm"
     stats = ReadStats()
     stream = DetectionStream(rec, config, stats, manifest=manifest, scenario=scenario)
-    _check_rendered_scans(rec, manifest, stream.scanned_sensors)
+    _check_rendered_scans(rec, manifest, stream.scanned_sensors, stream.sweep_files)
     duration_s = float(manifest.get("duration_s") or stream.nav["t"][-1])
     check_covers_run(stream.nav["t"], duration_s, rec)
     epochs = _EpochTimes(int(np.floor(duration_s * config.update_rate_hz + _EPOCH_COUNT_TOLERANCE)),

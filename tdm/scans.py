@@ -44,15 +44,19 @@ def start_time_unix_s(manifest: dict, recording: Path) -> float:
     return _start_time_unix_s(manifest, recording)
 
 
-def _lidar_jobs(rec: Path, lidar_source: str, manifest: dict, stats: ReadStats) -> Iterator | None:
-    """The LiDAR's front-end jobs (sweep files, or sweeps of the PCAP), or None when it has none."""
+def _lidar_jobs(rec: Path, lidar_source: str, manifest: dict, stats: ReadStats,
+                sweep_files: dict[str, int]) -> Iterator | None:
+    """The LiDAR's front-end jobs (sweep files, or sweeps of the PCAP), or None when it has none; how many sweep
+    files it reads goes into ``sweep_files`` (not for the PCAP)."""
     lidar_dir, pcap = rec / "lidar" / "sweeps", rec / "lidar" / "hdl32e.pcap"
     source = lidar_source
     has_npz = directory_present(lidar_dir)  # a file where the directory belongs is an error
     if source == "auto":
         source = "npz" if has_npz else "pcap"
     if source == "npz" and has_npz:
-        return (("lidar", p) for p in list_sweeps(lidar_dir, "lidar", stats))
+        files = list_sweeps(lidar_dir, "lidar", stats)
+        sweep_files["lidar"] = len(files)
+        return (("lidar", p) for p in files)
     if source == "pcap" and is_present(pcap):
         from tdm.pcap import check_pcap_header, iter_pcap_sweeps
 
@@ -66,18 +70,21 @@ def _lidar_jobs(rec: Path, lidar_source: str, manifest: dict, stats: ReadStats) 
 
 
 def _scan_jobs(recording: Path, config: TdmConfig, manifest: dict, description: RecordingDescription,
-               stats: ReadStats) -> Jobs:
-    """Per sensor: (iterator of front-end jobs in time order, scan period in s)."""
+               stats: ReadStats, sweep_files: dict[str, int]) -> Jobs:
+    """Per sensor: (iterator of front-end jobs in time order, scan period in s); how many sweep files each sensor
+    read from files has goes into ``sweep_files``."""
     rec = Path(recording)
     jobs: Jobs = {}
     lidar_period_s = description.lidar.period_s or 1.0 / DEFAULT_LIDAR_ROTATION_HZ
-    lidar = _lidar_jobs(rec, config.lidar_source, manifest, stats)
+    lidar = _lidar_jobs(rec, config.lidar_source, manifest, stats, sweep_files)
     if lidar is not None:
         jobs["lidar"] = (lidar, lidar_period_s)
     radar_dir = rec / "radar" / "sweeps"
     if directory_present(radar_dir):
         radar_period_s = description.radar.period_s or SECONDS_PER_MINUTE / DEFAULT_RADAR_RPM
-        jobs["radar"] = ((("radar", p) for p in list_sweeps(radar_dir, "radar", stats)), radar_period_s)
+        files = list_sweeps(radar_dir, "radar", stats)
+        sweep_files["radar"] = len(files)
+        jobs["radar"] = ((("radar", p) for p in files), radar_period_s)
     return jobs
 
 
@@ -125,6 +132,8 @@ class DetectionStream:
     description : RecordingDescription
         The recording's typed description (:func:`tdm.recording.description.describe`): its
         duration, the sensors' periods, ranges and mounts, read once for the whole run.
+    sweep_files : dict of str to int
+        How many sweep files each sensor read from ``<sensor>/sweeps`` has (not the LiDAR read from its PCAP).
     """
 
     def __init__(self, recording: Path, config: TdmConfig, stats: ReadStats, manifest: dict | None = None,
@@ -142,7 +151,8 @@ class DetectionStream:
         detection_mask = None if self.land is None else LandMask(self.land, self.ownship.frame, DETECTION_MARGIN_M)
         self._initargs = (self.ownship, self.description.lidar.mount, lidar_cfg, self.description.radar.mount,
                           radar_cfg, _sweep_limits(self.description), detection_mask)
-        self._jobs = _scan_jobs(rec, config, manifest, self.description, stats)
+        self.sweep_files: dict[str, int] = {}
+        self._jobs = _scan_jobs(rec, config, manifest, self.description, stats, self.sweep_files)
         self._chunk_scans = BATCH_SCANS
         ais_path = rec / "ais" / "ais.nmea"
         self.reports, self.static = [], {}

@@ -175,6 +175,8 @@ def test_missing_and_cut_sweeps_and_bad_nmea_are_counted_warnings(bos_recording,
     ("misspelt_key", "scenario.yaml: sensors.lidar.range_max_mm: unknown key (did you mean 'range_max_m'?)"),
     ("no_sensor_data", "holds no LiDAR, radar or AIS data"),
     ("radar_not_copied", "radar/sweeps: (directory): missing, though manifest.json lists radar as rendered"),
+    ("radar_sweeps_emptied", "radar/sweeps: (directory): holds none of the 16 sweep files manifest.json counts"),
+    ("lidar_sweeps_emptied", "lidar/sweeps: (directory): holds none of the 399 sweep files manifest.json counts"),
     ("pcap_garbage", "hdl32e.pcap"),
 ])
 def test_unreadable_recordings_give_one_line_and_exit_2(bos_recording, tmp_path, capsys, breakage, expect):
@@ -200,6 +202,8 @@ def test_unreadable_recordings_give_one_line_and_exit_2(bos_recording, tmp_path,
             shutil.rmtree(rec / "ais")
         elif breakage == "radar_not_copied":  # half-copied: the run would go on without the radar
             shutil.rmtree(rec / "radar")
+        elif breakage.endswith("_sweeps_emptied"):  # the directory copied, its files not
+            (rec / breakage.split("_")[0] / "sweeps").mkdir()
         elif breakage == "pcap_garbage":
             (rec / "lidar" / "hdl32e.pcap").write_bytes(b"\x00" * 100)
             extra = ["--lidar-source", "pcap"]
@@ -208,6 +212,19 @@ def test_unreadable_recordings_give_one_line_and_exit_2(bos_recording, tmp_path,
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("error: ") and expect in err
     assert not (rec / "tdm").exists()  # nothing left behind
+
+
+def test_a_run_shorter_than_a_radar_revolution_has_no_radar_sweep_and_runs(bos_recording, tmp_path, capsys):
+    """An empty radar/sweeps is a partial copy only where manifest.json counts sweeps: a 1 s run has none."""
+    rec = tmp_path / "rec"
+    shutil.copytree(bos_recording, rec, ignore=shutil.ignore_patterns("rosbag", "bev", "ppi", "sweeps", "tdm"))
+    (rec / "radar" / "sweeps").mkdir()
+    manifest = json.loads((rec / "manifest.json").read_text())
+    assert manifest["counts"]["radar/sweeps"] > 0
+    manifest["counts"]["radar/sweeps"] = 0
+    (rec / "manifest.json").write_text(json.dumps(manifest))
+    assert tdm_main(["run", str(rec)]) == 0
+    assert (rec / "tdm" / "detected_targets.jsonl").stat().st_size > 0
 
 
 def test_evaluate_without_a_run_is_an_error(bos_recording, tmp_path, capsys):
