@@ -243,7 +243,8 @@ class Fuser:
                         half_length_m: float) -> bool:
         """Whether absorbed track ``key`` stays with its target (``centre`` (6,), radius ``half_length_m``, m): while
         its ``state`` lies inside the footprint, and (``release_absorbed_on_plot``) while it has had no plot since it
-        last did: a coasting track moves on its own velocity, not on evidence that it is another object."""
+        last did: a coasting track moves on its own velocity, not on evidence that it is another object. Inside, the
+        time of its last plot is recorded (``_inside_at_s``)."""
         if self._inside(state, centre, half_length_m):
             self._inside_at_s[key] = tr.updated_s
             return True

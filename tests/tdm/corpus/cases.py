@@ -89,6 +89,14 @@ def _no_sensor_data(rec: Path) -> None:
         shutil.rmtree(rec / folder)
 
 
+def _emptied(sensor: str):
+    """``<sensor>/sweeps`` copied without its files (a partial copy)."""
+    def corrupt(rec: Path) -> None:
+        shutil.rmtree(rec / sensor / "sweeps")
+        (rec / sensor / "sweeps").mkdir()
+    return corrupt
+
+
 def _pickled_x(rec: Path) -> None:
     path = rec / lidar(10)
     with np.load(path) as z:
@@ -149,6 +157,13 @@ CASES: list[Case] = [
          *[err("", "(directory)", "not a directory")] * 3),
     Case("no_sensor_data", "lidar/, radar/ and ais/ removed", _no_sensor_data,
          OK, err("", "(directory)", "holds no LiDAR, radar or AIS data"), OK),
+    Case("radar_not_copied", "radar/ removed (manifest.json lists the radar as rendered)",
+         lambda rec: shutil.rmtree(rec / "radar"),
+         OK, err("radar/sweeps", "(directory)", "missing, though manifest.json lists radar as rendered"), OK),
+    Case("radar_sweeps_emptied", "radar/sweeps copied without its files", _emptied("radar"),
+         OK, err("radar/sweeps", "(directory)", "holds none of the 2 sweep files manifest.json counts"), OK),
+    Case("lidar_sweeps_emptied", "lidar/sweeps copied without its files", _emptied("lidar"),
+         OK, err("lidar/sweeps", "(directory)", "holds none of the 59 sweep files manifest.json counts"), OK),
     Case("manifest_missing", "manifest.json removed", at(M, remove), *[err(M, "(file)", "missing")] * 3),
     Case("manifest_zero_bytes", "manifest.json of zero bytes", _bytes(M, b""), *[err(M, "(file)", "empty")] * 3),
     Case("manifest_cut", "manifest.json cut after 40 bytes", at(M, cut, 40),
