@@ -60,13 +60,15 @@ from tdm.fusion_geometry import major_variance as _major_variance
 from tdm.fusion_geometry import moves_apart as _moves_apart
 from tdm.fusion_consider import reported_covariance
 from tdm.fusion_face import STILL_DESCRIPTORS, behind_the_face
-from tdm.fusion_rules import fuse
-from tdm.fusion_weights import member_hull_covariance, with_extent, with_fragments, with_hull
+from tdm.fusion_rules import fuse, without_stray_velocities
+from tdm.fusion_weights import member_hull_covariance, with_extent, with_face_turn, with_fragments, with_hull
 from tdm.tracker import Track, predicted_at
 
 
 #: Degrees of freedom of the track-to-track gate: east and north position.
 POSITION_DOF = 2
+#: Degrees of freedom of the AIS velocity gate (FusionConfig.ais_velocity_gate_probability): east and north velocity.
+VELOCITY_DOF = 2
 #: A member leaves its target when its statistic exceeds this many gates, or its distance this many
 #: ``max_distance_m``: looser than joining, so that a track does not flicker in and out.
 RELEASE_GATES = 4
@@ -118,30 +120,37 @@ class Fuser:
         self._inside_at_s: dict[tuple[str, int], float] = {}  # absorbed track -> its last plot's time while inside
         self._ids = itertools.count(1)
         self._gate = chi2_gate(config.gate_probability, POSITION_DOF)
+        self._velocity_gate = None if config.ais_velocity_gate_probability is None else \
+            chi2_gate(config.ais_velocity_gate_probability, VELOCITY_DOF)
         self._classifier = Classifier(config)
         self._memo: dict | None = None  # the fused estimates of one step (_estimate)
 
     def step(self, t_s: float, tracks_by_sensor: dict[str, list[Track]],
-             own_position_m: np.ndarray | None = None) -> list[FusedEstimate]:
+             own_position_m: np.ndarray | None = None,
+             own_velocity_mps: np.ndarray | None = None) -> list[FusedEstimate]:
         """Associate the confirmed tracks at ``t_s`` and return every target's fused estimate.
 
         ``own_position_m`` (2,), the own ship's east and north at ``t_s`` (m), lets still targets' radar tracks
         be put behind their painted face (``radar_hidden_depth_fraction``) and the other radar tracks' face offset be
         reported along the line of sight (``consider_radar_face``), and the heading bias's share of the own ship's
         navigation bias (``consider_nav_bias``); None or not finite: as they are, no face offset, and the position
-        bias alone.
+        bias alone. ``own_velocity_mps`` (2,), its velocity (m/s), lets the velocity of the tracks of a sensor that
+        sees a side be weighed with that side's turning (``face_turn_scale``); None: not.
         """
         self._memo = {}
         if own_position_m is not None:
             own_position_m = np.asarray(own_position_m, dtype=float)[:2]
             own_position_m = own_position_m if np.all(np.isfinite(own_position_m)) else None
+        if own_velocity_mps is not None:
+            own_velocity_mps = np.asarray(own_velocity_mps, dtype=float)[:2]
+            own_velocity_mps = own_velocity_mps if np.all(np.isfinite(own_velocity_mps)) else None
         try:
-            return self._step(t_s, tracks_by_sensor, own_position_m)
+            return self._step(t_s, tracks_by_sensor, own_position_m, own_velocity_mps)
         finally:
             self._memo = None
 
     def _step(self, t_s: float, tracks_by_sensor: dict[str, list[Track]],
-              own_position_m: np.ndarray | None) -> list[FusedEstimate]:
+              own_position_m: np.ndarray | None, own_velocity_mps: np.ndarray | None) -> list[FusedEstimate]:
         """:meth:`step`, with the fused estimates of the step kept (:meth:`_estimate`)."""
         cfg = self.config
         live = {(s, tr.track_id): tr for s, trs in tracks_by_sensor.items() for tr in trs}
@@ -204,6 +213,9 @@ class Fuser:
                               cfg.hull_sensors)
         if cfg.fragment_sensors:
             weigh = with_fragments(weigh, self.targets, cfg.fragment_sensors)
+        if cfg.face_turn_scale > 0.0 and own_position_m is not None and own_velocity_mps is not None:
+            weigh = with_face_turn(weigh, live, own_position_m, own_velocity_mps, cfg.face_turn_scale,
+                                   cfg.face_turn_sensors)
         for target in self.targets:
             x, p = self._estimate(target, weigh)
             reported_p = reported_covariance(target, x, p, weigh, live, own_position_m, moved, cfg)
@@ -344,7 +356,9 @@ class Fuser:
             return memo[key]
         xs = np.array([states[(s, i)][0] for s, i in target.members.items()])
         ps = np.array([states[(s, i)][1] for s, i in target.members.items()])
-        out = fuse(xs, ps, self.config.rule)
+        if self._velocity_gate is not None and "ais" in target.members and len(xs) > 1:
+            ps = without_stray_velocities(xs, ps, list(target.members).index("ais"), self._velocity_gate)
+        out = fuse(xs, ps, self.config.rule, self.config.fuse_velocity)
         if memo is not None:
             memo[key] = out
         return out
@@ -547,7 +561,7 @@ class Fuser:
                 break
             xs = np.array([states[k][0] for k in others])
             ps = np.array([states[k][1] for k in others])
-            x, p = fuse(xs, ps, self.config.rule)
+            x, p = fuse(xs, ps, self.config.rule, self.config.fuse_velocity)
             xi, pi_ = states[key]
             d = xi[:2] - x[:2]
             if self._released(d, pi_[:2, :2] + p[:2, :2]):

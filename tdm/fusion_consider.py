@@ -70,4 +70,4 @@ def reported_covariance(target: FusedTarget, x: np.ndarray, p: np.ndarray, state
         return p
     xs = np.array([states[k][0] for k in keys])
     ps = np.array([states[k][1] for k in keys])
-    return p + consider_covariance(xs, ps, v, config.rule, nav, shared)
+    return p + consider_covariance(xs, ps, v, config.rule, nav, shared, config.fuse_velocity)

@@ -7,10 +7,11 @@ import numpy as np
 
 from tdm import ekf
 
-__all__ = ["canonical_states", "consider_covariance", "fuse"]
+__all__ = ["canonical_states", "consider_covariance", "from_cartesian", "fuse", "to_cartesian"]
 
 
-def fuse(xs: np.ndarray, ps: np.ndarray, rule: str = "simple") -> tuple[np.ndarray, np.ndarray]:
+def fuse(xs: np.ndarray, ps: np.ndarray, rule: str = "simple",
+         velocity: str = "polar") -> tuple[np.ndarray, np.ndarray]:
     """Fuse K estimates of one object.
 
     Parameters
@@ -18,6 +19,11 @@ def fuse(xs: np.ndarray, ps: np.ndarray, rule: str = "simple") -> tuple[np.ndarr
     xs : (K, 6) float
     ps : (K, 6, 6) float
     rule : {"simple", "ci"}
+    velocity : {"polar", "cartesian"}
+        Fuse the velocities as course and speed, or as east and north velocity (:func:`to_cartesian`; the
+        result turned back to course and speed, :func:`from_cartesian`). Course and speed average the speeds
+        of a still object's estimates, each of them the size of its error and so too high, whatever their
+        directions; east and north average the errors themselves.
 
     Returns
     -------
@@ -26,6 +32,14 @@ def fuse(xs: np.ndarray, ps: np.ndarray, rule: str = "simple") -> tuple[np.ndarr
     """
     if len(xs) == 1:
         return xs[0].copy(), ps[0].copy()
+    if velocity == "cartesian":
+        ys, qs = to_cartesian(xs, ps)
+        infos, q = _weighted_informations(qs, rule)
+        y = q @ np.einsum("kij,kj->i", infos, ys)
+        x, p = from_cartesian(y, 0.5 * (q + q.T))
+        return x, 0.5 * (p + p.T)
+    if velocity != "polar":
+        raise ValueError(f"unknown velocity frame {velocity!r}")
     xs, ps = canonical_states(xs, ps)
     ref = xs[0, ekf.PSI]
     xs[:, ekf.PSI] = ref + ekf.wrap_pi(xs[:, ekf.PSI] - ref)  # angles relative to one branch
@@ -33,6 +47,65 @@ def fuse(xs: np.ndarray, ps: np.ndarray, rule: str = "simple") -> tuple[np.ndarr
     x = p @ np.einsum("kij,kj->i", infos, xs)
     x[ekf.PSI] = ekf.wrap_pi(x[ekf.PSI])
     return x, 0.5 * (p + p.T)
+
+
+#: Smallest speed the course's uncertainty is scaled by, turning a state to or from east and north velocity, m/s:
+#: a still estimate's course is not known, and its velocity's covariance must stay invertible.
+CARTESIAN_SPEED_FLOOR_MPS = 0.05
+
+
+def to_cartesian(xs: np.ndarray, ps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Estimates with course and speed (:mod:`tdm.ekf`) turned to east and north velocity.
+
+    ``[e, n, psi, u, r, alpha]`` -> ``[e, n, u sin psi, u cos psi, r, alpha]``, the covariance through the
+    Jacobian at the estimate, the course's column scaled by the speed's size, not under
+    :data:`CARTESIAN_SPEED_FLOOR_MPS`.
+
+    Parameters
+    ----------
+    xs : (K, 6) float
+    ps : (K, 6, 6) float
+
+    Returns
+    -------
+    ys : (K, 6) float
+    qs : (K, 6, 6) float
+    """
+    xs, ps = np.asarray(xs, dtype=float), np.asarray(ps, dtype=float)
+    psi, u = xs[:, ekf.PSI], xs[:, ekf.U]
+    sin, cos = np.sin(psi), np.cos(psi)
+    lever = np.copysign(np.maximum(np.abs(u), CARTESIAN_SPEED_FLOOR_MPS), u)
+    ys = xs.copy()
+    ys[:, ekf.PSI], ys[:, ekf.U] = u * sin, u * cos
+    jac = np.broadcast_to(np.eye(ekf.N_STATES), ps.shape).copy()
+    jac[:, ekf.PSI, ekf.PSI], jac[:, ekf.PSI, ekf.U] = lever * cos, sin
+    jac[:, ekf.U, ekf.PSI], jac[:, ekf.U, ekf.U] = -lever * sin, cos
+    return ys, jac @ ps @ jac.transpose(0, 2, 1)
+
+
+def from_cartesian(y: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """One estimate with east and north velocity (:func:`to_cartesian`) turned back to course and speed (>= 0).
+
+    Parameters
+    ----------
+    y : (6,) float
+    q : (6, 6) float
+
+    Returns
+    -------
+    x : (6,) float
+    p : (6, 6) float
+    """
+    ve, vn = float(y[ekf.PSI]), float(y[ekf.U])
+    speed = float(np.hypot(ve, vn))
+    x = np.array(y, dtype=float)
+    x[ekf.PSI], x[ekf.U] = ekf.wrap_pi(np.arctan2(ve, vn)), speed
+    lever = max(speed, CARTESIAN_SPEED_FLOOR_MPS)
+    sin, cos = (ve / speed, vn / speed) if speed > 0.0 else (0.0, 1.0)
+    jac = np.eye(ekf.N_STATES)
+    jac[ekf.PSI, ekf.PSI], jac[ekf.PSI, ekf.U] = cos / lever, -sin / lever
+    jac[ekf.U, ekf.PSI], jac[ekf.U, ekf.U] = sin, cos
+    return x, jac @ q @ jac.T
 
 
 def _weighted_informations(ps: np.ndarray, rule: str) -> tuple[np.ndarray, np.ndarray]:
@@ -49,7 +122,8 @@ def _weighted_informations(ps: np.ndarray, rule: str) -> tuple[np.ndarray, np.nd
 
 
 def consider_covariance(xs: np.ndarray, ps: np.ndarray, position_var_m2: np.ndarray, rule: str = "simple",
-                        shared_var_m2: np.ndarray | None = None, shared: np.ndarray | None = None) -> np.ndarray:
+                        shared_var_m2: np.ndarray | None = None, shared: np.ndarray | None = None,
+                        velocity: str = "polar") -> np.ndarray:
     """Covariance of the error a fusion (:func:`fuse`) takes over from biases of its estimates' positions.
 
     Each estimate's position may carry a bias its covariance does not hold (a sensor sees the near side of an
@@ -86,13 +160,21 @@ def consider_covariance(xs: np.ndarray, ps: np.ndarray, position_var_m2: np.ndar
         out = np.zeros((ekf.N_STATES, ekf.N_STATES))
         out[:2, :2] = v[0] + (shared_var_m2 if shared_var_m2 is not None and mask[0] else 0.0)
         return out
-    _, ps = canonical_states(xs, ps)
-    infos, p = _weighted_informations(ps, rule)
-    cols = np.einsum("ij,kjl->kil", p, infos[:, :, :2])  # (K, 6, 2): W_k[:, :2]
+    if velocity == "cartesian":
+        ys, qs = to_cartesian(xs, ps)
+        infos, q = _weighted_informations(qs, rule)
+    else:
+        _, ps = canonical_states(xs, ps)
+        infos, q = _weighted_informations(ps, rule)
+    cols = np.einsum("ij,kjl->kil", q, infos[:, :, :2])  # (K, 6, 2): W_k[:, :2]
     out = np.einsum("kab,kia,kjb->ij", v, cols, cols)
     if shared_var_m2 is not None and mask.any():
         s = cols[mask].sum(axis=0)  # (6, 2)
         out = out + s @ np.asarray(shared_var_m2, dtype=float) @ s.T
+    out = 0.5 * (out + out.T)
+    if velocity == "cartesian":  # the velocity's rows and columns back to course and speed, at the fused velocity
+        y = q @ np.einsum("kij,kj->i", infos, ys)
+        _, out = from_cartesian(y, out)
     return 0.5 * (out + out.T)
 
 
@@ -123,3 +205,46 @@ def canonical_states(xs: np.ndarray, ps: np.ndarray) -> tuple[np.ndarray, np.nda
         sign[ekf.U] = -1.0
         ps[flip] = ps[flip] * sign[None, :, None] * sign[None, None, :]
     return xs, ps
+
+
+#: Variance given to a velocity left out of a fusion (:func:`without_stray_velocities`), (m/s)^2 and rad^2.
+LEFT_OUT_VELOCITY_VAR = 1.0e6
+
+
+def without_stray_velocities(xs: np.ndarray, ps: np.ndarray, anchor: int, gate_chi2: float) -> np.ndarray:
+    """(K, 6, 6) ``ps`` with the velocity of every estimate that the ``anchor`` estimate's velocity rules out left
+    out: its course and speed given :data:`LEFT_OUT_VELOCITY_VAR` and no correlation with the rest, so that it adds
+    its position and cross-section alone to a fusion.
+
+    An estimate's velocity is ruled out when its east and north velocity (:func:`to_cartesian`) lies more than
+    ``gate_chi2`` (chi-square, 2 dof) from the anchor's, by their summed covariances. The anchor is the estimate
+    whose velocity is measured (an AIS ship's GNSS course and speed) where the others' is inferred from positions
+    of a shape that changes as it is seen (a LiDAR cluster's seen side, a radar echo's fragments).
+
+    Parameters
+    ----------
+    xs : (K, 6) float
+    ps : (K, 6, 6) float
+    anchor : int
+    gate_chi2 : float
+
+    Returns
+    -------
+    (K, 6, 6) float
+        A copy where any velocity is left out, else ``ps`` itself.
+    """
+    ys, qs = to_cartesian(xs, ps)
+    vel = slice(ekf.PSI, ekf.U + 1)
+    d = ys[:, vel] - ys[anchor, vel]
+    s = qs[:, vel, vel] + qs[anchor, vel, vel]
+    d2 = np.einsum("ki,kij,kj->k", d, np.linalg.inv(s), d)
+    stray = d2 > gate_chi2
+    stray[anchor] = False
+    if not stray.any():
+        return ps
+    out = np.array(ps, dtype=float)
+    for idx in (ekf.PSI, ekf.U):
+        out[stray, idx, :] = 0.0
+        out[stray, :, idx] = 0.0
+        out[stray, idx, idx] = LEFT_OUT_VELOCITY_VAR
+    return out

@@ -13,7 +13,11 @@ import numpy as np
 
 from tdm.hull import BEAM_PER_LENGTH, hull_covariance
 
-__all__ = ["member_hull_covariance", "with_extent", "with_fragments", "with_hull"]
+__all__ = ["face_turn_speed_sigma_mps", "member_hull_covariance", "with_extent", "with_face_turn", "with_fragments",
+           "with_hull"]
+
+#: Smallest speed a track's course share of the face turn is divided by, m/s (a still object's course is unknown).
+COURSE_SPEED_FLOOR_MPS = 0.5
 
 
 def with_extent(states: dict, live: dict) -> dict:
@@ -129,3 +133,71 @@ def with_fragments(states: dict, targets: list, sensors: tuple[str, ...] = ("rad
             out = dict(states) if out is None else out
             out[key] = (x, p)
     return states if out is None else out
+
+
+def face_turn_speed_sigma_mps(x: np.ndarray, offset_sigma_m: np.ndarray, own_position_m: np.ndarray,
+                              own_velocity_mps: np.ndarray) -> np.ndarray:
+    """Standard deviation of the velocity a track takes from its seen side turning with the line of sight, m/s.
+
+    A sensor that sees an object's near side tracks the middle of that side, which lies an offset (of standard
+    deviation ``offset_sigma_m``) from the object's centre toward the sensor. As the own ship moves past, the line
+    of sight turns at ``omega = |los x v_rel| / range^2`` (rad/s, ``v_rel`` the object's velocity less the own
+    ship's) and the offset turns with it: the tracked point moves at ``offset omega`` across the line of sight
+    though the object may not move at all.
+
+    Parameters
+    ----------
+    x : (K, 6) float
+        The tracks' states (:mod:`tdm.ekf`).
+    offset_sigma_m : (K,) float
+        Standard deviation of each track's offset from the object's centre, m.
+    own_position_m, own_velocity_mps : (2,) float
+        The own ship's east and north, m, and its velocity, m/s.
+
+    Returns
+    -------
+    (K,) float
+        m/s; 0 within 1 m of the own ship.
+    """
+    x = np.asarray(x, dtype=float).reshape(-1, 6)
+    los = x[:, :2] - np.asarray(own_position_m, dtype=float)[:2]
+    speed = x[:, 3]
+    v_rel = np.stack([speed * np.sin(x[:, 2]), speed * np.cos(x[:, 2])], axis=1) - np.asarray(own_velocity_mps)[:2]
+    range2 = np.einsum("ki,ki->k", los, los)
+    cross = np.abs(los[:, 0] * v_rel[:, 1] - los[:, 1] * v_rel[:, 0])
+    omega = np.divide(cross, range2, out=np.zeros_like(cross), where=range2 > 1.0)
+    return np.asarray(offset_sigma_m, dtype=float) * omega
+
+
+def with_face_turn(states: dict, live: dict, own_position_m: np.ndarray, own_velocity_mps: np.ndarray,
+                   scale: float, sensors: tuple[str, ...] = ("lidar",)) -> dict:
+    """``states`` with the velocity a track of ``sensors`` takes from its seen side turning
+    (:func:`face_turn_speed_sigma_mps`; the offset's standard deviation ``scale`` times the root of the track's
+    ``Track.extent_var_m2``) added to its speed's variance, and over its speed (not under
+    :data:`COURSE_SPEED_FLOOR_MPS`) to its course's (``FusionConfig.face_turn_scale``).
+
+    Parameters
+    ----------
+    states : dict
+        (sensor, track id) -> ((6,), (6, 6)).
+    live : dict
+        (sensor, track id) -> Track.
+    own_position_m, own_velocity_mps : (2,) float
+        m and m/s.
+    scale : float
+    sensors : tuple of str
+    """
+    keys = [k for k, tr in live.items() if k[0] in sensors and k in states and tr.extent_var_m2 > 0.0]
+    if not keys or scale <= 0.0:
+        return states
+    x = np.array([states[k][0] for k in keys])
+    offset = scale * np.sqrt([live[k].extent_var_m2 for k in keys])
+    var = face_turn_speed_sigma_mps(x, offset, own_position_m, own_velocity_mps) ** 2
+    course_var = var / np.maximum(np.abs(x[:, 3]), COURSE_SPEED_FLOOR_MPS) ** 2
+    out = dict(states)
+    for k, key in enumerate(keys):
+        p = states[key][1].copy()
+        p[3, 3] += var[k]
+        p[2, 2] += course_var[k]
+        out[key] = (states[key][0], p)
+    return out

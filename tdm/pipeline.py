@@ -124,7 +124,8 @@ class _Tracking:
         by_sensor["ais"] = self.ais.confirmed_tracks()
         own = self.ownship.position_m(np.array([t_out]))[0, :2]
         targets = []
-        for estimate in self.fuser.step(t_out, by_sensor, own):
+        own_velocity = self.ownship.velocity_mps(np.array([t_out]))[0]
+        for estimate in self.fuser.step(t_out, by_sensor, own, own_velocity):
             tgt = estimate.target
             if self.on_land(estimate.x):
                 continue

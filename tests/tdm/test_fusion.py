@@ -108,12 +108,18 @@ def test_the_hidden_depth_is_a_fraction_of_the_core_width_where_the_object_spans
         FusionConfig(consider_nav_bias=False, radar_hidden_depth_size="width")
 
 
-@pytest.mark.parametrize("field", ["join_free_slot", "hull_sensors", "fragment_sensors"])
+@pytest.mark.parametrize("field", ["join_free_slot", "hull_sensors", "fragment_sensors", "face_turn_sensors"])
 def test_a_misspelt_sensor_in_a_fusion_setting_is_an_error_not_a_rule_quietly_off(field):
     with pytest.raises(ValueError, match=f"{field}: unknown sensor 'lider'"):
         FusionConfig(**{field: ("lider",)})
     with pytest.raises(ValueError, match="promote_after_s"):
         FusionConfig(promote_after_s=float("nan"))
+    with pytest.raises(ValueError, match="fuse_velocity"):
+        FusionConfig(fuse_velocity="east-north")
+    with pytest.raises(ValueError, match="face_turn_scale"):
+        FusionConfig(face_turn_scale=-1.0)
+    with pytest.raises(ValueError, match="ais_velocity_gate_probability"):
+        FusionConfig(ais_velocity_gate_probability=1.0)
     assert getattr(FusionConfig(**{field: ()}), field) == ()
 
 
