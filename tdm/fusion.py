@@ -60,7 +60,7 @@ from tdm.fusion_geometry import major_variance as _major_variance
 from tdm.fusion_geometry import moves_apart as _moves_apart
 from tdm.fusion_consider import reported_covariance
 from tdm.fusion_face import STILL_DESCRIPTORS, behind_the_face
-from tdm.fusion_rules import fuse, without_stray_velocities
+from tdm.fusion_rules import fuse, velocity_frame, without_stray_velocities
 from tdm.fusion_weights import member_hull_covariance, with_extent, with_face_turn, with_fragments, with_hull
 from tdm.tracker import Track, predicted_at
 
@@ -358,7 +358,7 @@ class Fuser:
         ps = np.array([states[(s, i)][1] for s, i in target.members.items()])
         if self._velocity_gate is not None and "ais" in target.members and len(xs) > 1:
             ps = without_stray_velocities(xs, ps, list(target.members).index("ais"), self._velocity_gate)
-        out = fuse(xs, ps, self.config.rule, self.config.fuse_velocity)
+        out = fuse(xs, ps, self.config.rule, velocity_frame(self.config.fuse_velocity, target.members))
         if memo is not None:
             memo[key] = out
         return out
@@ -561,7 +561,8 @@ class Fuser:
                 break
             xs = np.array([states[k][0] for k in others])
             ps = np.array([states[k][1] for k in others])
-            x, p = fuse(xs, ps, self.config.rule, self.config.fuse_velocity)
+            x, p = fuse(xs, ps, self.config.rule,
+                        velocity_frame(self.config.fuse_velocity, [k[0] for k in others]))
             xi, pi_ = states[key]
             d = xi[:2] - x[:2]
             if self._released(d, pi_[:2, :2] + p[:2, :2]):

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from tdm.fusion_rules import VELOCITY_FRAMES
+
 __all__ = ["FusionConfig", "TRACK_SENSORS"]
 
 #: The sensors whose tracks a target's members are, besides its AIS track.
@@ -125,19 +127,22 @@ class FusionConfig:
     # tracks' positions, their scatter in its covariance (tdm.fusion_weights.with_fragments): a large object's
     # centre lies among the parts its plots fall on
     fragment_sensors: tuple[str, ...] = ("radar",)
-    # fuse the members' velocities as east and north velocity ("cartesian"), not as course and speed ("polar";
-    # tdm.fusion_rules.fuse): course and speed average a still berg's speeds, each of them the size of its
-    # sensor's error, whatever their directions. With the two settings below, on busy_open_sea seeds 1-4 and 7
-    # (300 s, tuning): median fused error within LiDAR range 2.06/2.36/2.36/2.03/2.34 -> 1.93/2.49/1.96/1.94/1.97 m,
-    # fused COG RMSE 14.9/10.8/19.9/22.7/17.4 -> 22.7/7.2/11.2/13.5/9.3 deg, objects where the fusion is no worse
-    # than its best sensor on SOG RMSE 8 -> 10 of 30, on all six figures 0 -> 2 (docs/tdm.md, "Velocity"); course
-    # and speed with the same two settings: 1.96/2.47/2.28/1.94/2.32 m, 0 of 30 on all six
-    fuse_velocity: str = "cartesian"
+    # fuse the members' velocities as east and north velocity ("cartesian") where no AIS track is among them, as
+    # course and speed where one is ("cartesian_without_ais"; tdm.fusion_rules.velocity_frame), or always one way
+    # ("cartesian", "polar", the only way until 2026-11-29). Course and speed average a still berg's speeds, each the
+    # size of its sensor's error, whatever their directions; the AIS measures course and speed, and east and north
+    # let a radar velocity a few tenths of a m/s off turn a slow ship's course (busy_open_sea seed 1, the 0.5 m/s
+    # support vessel: its fused COG RMSE 14.9 -> 22.7 deg with "cartesian", 12.3 with this). With the two settings
+    # below, on busy_open_sea seeds 1-4 and 7 (300 s, tuning): median fused error within LiDAR range
+    # 2.06/2.36/2.36/2.03/2.34 -> 1.90/2.47/1.94/1.94/1.97 m, fused COG RMSE 14.9/10.8/19.9/22.7/17.4 ->
+    # 12.3/6.9/17.8/19.1/7.9 deg, objects where the fusion is no worse than its best sensor on SOG RMSE 8 -> 12 of
+    # 30, on all six figures 0 -> 2 (docs/tdm.md, "Fusion")
+    fuse_velocity: str = "cartesian_without_ais"
     # weigh the velocity of the tracks of these sensors with what their seen side's turning with the line of sight
     # lends it (tdm.fusion_weights.with_face_turn): the side's offset from the centre, scale times its standard
     # deviation (Track.extent_var_m2, the LiDAR's 0.15 of its length), turns at the line of sight's rate. Scale 1:
-    # the offset the tracker already reports, nothing fitted (0 on the same seeds: COG RMSE 23.9/8.9/13.1/13.8/11.6
-    # deg, the same median errors within 0.07 m). 0: off
+    # the offset the tracker already reports, nothing fitted (with "cartesian" on the same seeds, scale 0 against 1:
+    # COG RMSE 23.9/8.9/13.1/13.8/11.6 against 22.7/7.2/11.2/13.5/9.3 deg, median errors within 0.07 m). 0: off
     face_turn_scale: float = 1.0
     face_turn_sensors: tuple[str, ...] = ("lidar",)
     # a member of an AIS ship's target whose velocity lies outside the gate of this probability (chi-square, 2 dof)
@@ -170,8 +175,8 @@ class FusionConfig:
     nav_heading_bias_deg: float = 0.1
 
     def __post_init__(self):
-        if self.fuse_velocity not in ("polar", "cartesian"):
-            raise ValueError(f"fuse_velocity must be 'polar' or 'cartesian', not {self.fuse_velocity!r}")
+        if self.fuse_velocity not in VELOCITY_FRAMES:
+            raise ValueError(f"fuse_velocity must be one of {', '.join(VELOCITY_FRAMES)}, not {self.fuse_velocity!r}")
         if self.radar_hidden_depth_size not in ("core_width", "length"):
             raise ValueError(f"radar_hidden_depth_size must be 'core_width' or 'length', "
                              f"not {self.radar_hidden_depth_size!r}")

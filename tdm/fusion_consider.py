@@ -19,7 +19,7 @@ import numpy as np
 
 from tdm.fusion_config import FusionConfig
 from tdm.fusion_face import face_covariance
-from tdm.fusion_rules import consider_covariance
+from tdm.fusion_rules import consider_covariance, velocity_frame
 from tdm.nav_bias import NAV_RELATIVE_SENSORS, nav_bias_covariance
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -70,4 +70,5 @@ def reported_covariance(target: FusedTarget, x: np.ndarray, p: np.ndarray, state
         return p
     xs = np.array([states[k][0] for k in keys])
     ps = np.array([states[k][1] for k in keys])
-    return p + consider_covariance(xs, ps, v, config.rule, nav, shared, config.fuse_velocity)
+    return p + consider_covariance(xs, ps, v, config.rule, nav, shared,
+                                   velocity_frame(config.fuse_velocity, target.members))

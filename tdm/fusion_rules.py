@@ -7,7 +7,23 @@ import numpy as np
 
 from tdm import ekf
 
-__all__ = ["canonical_states", "consider_covariance", "from_cartesian", "fuse", "to_cartesian"]
+__all__ = ["VELOCITY_FRAMES", "canonical_states", "consider_covariance", "from_cartesian", "fuse", "to_cartesian",
+           "velocity_frame", "without_stray_velocities"]
+
+
+#: What ``FusionConfig.fuse_velocity`` may say (:func:`velocity_frame`).
+VELOCITY_FRAMES = ("polar", "cartesian", "cartesian_without_ais")
+
+
+def velocity_frame(setting: str, sensors) -> str:
+    """The frame :func:`fuse` averages the velocities of estimates from ``sensors`` in, by ``setting``
+    (:data:`VELOCITY_FRAMES`): ``cartesian_without_ais`` is ``polar`` where an AIS track is among them (it measures
+    the ship's course and speed, so its errors are Gaussian in those, and the course it gives a slow ship holds
+    where an east-north average with a radar or LiDAR velocity a few tenths of a m/s off would turn it), else
+    ``cartesian``."""
+    if setting == "cartesian_without_ais":
+        return "polar" if "ais" in sensors else "cartesian"
+    return setting
 
 
 def fuse(xs: np.ndarray, ps: np.ndarray, rule: str = "simple",

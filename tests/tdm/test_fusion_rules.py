@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from tdm import ekf
-from tdm.fusion_rules import from_cartesian, fuse, to_cartesian, without_stray_velocities
+from tdm.fusion_rules import from_cartesian, fuse, to_cartesian, velocity_frame, without_stray_velocities
 
 
 def _estimate(east, north, course_deg, speed_mps, var_m2=4.0, course_sd_deg=20.0, speed_sd_mps=0.3):
@@ -73,3 +73,18 @@ def test_a_velocity_the_ais_rules_out_is_left_out_and_its_position_kept():
     assert x_gated[0] == pytest.approx(x_all[0], abs=0.2)  # the LiDAR's position still counts
     kept = ps[[0, 2]]
     assert without_stray_velocities(xs[[0, 2]], kept, 0, 18.42) is kept
+
+
+def test_a_target_with_ais_fuses_course_and_speed_one_without_east_and_north():
+    """The AIS measures course and speed: with it among the members the velocities are averaged as those (a slow
+    ship's AIS course holds against a radar velocity 1 m/s the other way, where east and north would turn it)."""
+    assert velocity_frame("cartesian_without_ais", {"ais": 1, "radar": 2}) == "polar"
+    assert velocity_frame("cartesian_without_ais", ["lidar", "radar"]) == "cartesian"
+    assert velocity_frame("polar", ["lidar"]) == "polar" and velocity_frame("cartesian", ["ais"]) == "cartesian"
+    ais = _estimate(0.0, 0.0, 90.0, 0.5, course_sd_deg=3.0, speed_sd_mps=0.4)
+    radar = _estimate(0.0, 0.0, -90.0, 0.6, course_sd_deg=40.0, speed_sd_mps=0.5)
+    xs, ps = np.array([ais[0], radar[0]]), np.array([ais[1], radar[1]])
+    x_polar, _ = fuse(xs, ps, velocity=velocity_frame("cartesian_without_ais", ["ais", "radar"]))
+    x_cart, _ = fuse(xs, ps, velocity="cartesian")
+    assert math.degrees(x_polar[ekf.PSI]) == pytest.approx(90.0, abs=3.0)
+    assert math.cos(x_cart[ekf.PSI] - math.pi / 2) < 0.0 or x_cart[ekf.U] < 0.1
