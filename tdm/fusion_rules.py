@@ -1,5 +1,7 @@
 """The rules that fuse several estimates of one object: Simple Fusion (thesis eq. 3.2) and covariance
-intersection (:mod:`tdm.fusion`), on states whose speed is made non-negative first."""
+intersection (:mod:`tdm.fusion`), with the velocities averaged as course and speed (the speed made non-negative
+first) or as east and north velocity (:func:`velocity_frame`), and velocities an AIS track rules out left out
+(:func:`without_stray_velocities`)."""
 
 from __future__ import annotations
 
