@@ -11,6 +11,7 @@ import math
 
 import numpy as np
 
+from tdm import ekf
 from tdm.hull import BEAM_PER_LENGTH, hull_covariance
 
 __all__ = ["face_turn_speed_sigma_mps", "member_hull_covariance", "with_extent", "with_face_turn", "with_fragments",
@@ -159,10 +160,9 @@ def face_turn_speed_sigma_mps(x: np.ndarray, offset_sigma_m: np.ndarray, own_pos
     (K,) float
         m/s; 0 within 1 m of the own ship.
     """
-    x = np.asarray(x, dtype=float).reshape(-1, 6)
+    x = np.asarray(x, dtype=float).reshape(-1, ekf.N_STATES)
     los = x[:, :2] - np.asarray(own_position_m, dtype=float)[:2]
-    speed = x[:, 3]
-    v_rel = np.stack([speed * np.sin(x[:, 2]), speed * np.cos(x[:, 2])], axis=1) - np.asarray(own_velocity_mps)[:2]
+    v_rel = ekf.velocity_en(x) - np.asarray(own_velocity_mps)[:2]
     range2 = np.einsum("ki,ki->k", los, los)
     cross = np.abs(los[:, 0] * v_rel[:, 1] - los[:, 1] * v_rel[:, 0])
     omega = np.divide(cross, range2, out=np.zeros_like(cross), where=range2 > 1.0)
@@ -193,11 +193,11 @@ def with_face_turn(states: dict, live: dict, own_position_m: np.ndarray, own_vel
     x = np.array([states[k][0] for k in keys])
     offset = scale * np.sqrt([live[k].extent_var_m2 for k in keys])
     var = face_turn_speed_sigma_mps(x, offset, own_position_m, own_velocity_mps) ** 2
-    course_var = var / np.maximum(np.abs(x[:, 3]), COURSE_SPEED_FLOOR_MPS) ** 2
+    course_var = var / np.maximum(np.abs(x[:, ekf.U]), COURSE_SPEED_FLOOR_MPS) ** 2
     out = dict(states)
     for k, key in enumerate(keys):
         p = states[key][1].copy()
-        p[3, 3] += var[k]
-        p[2, 2] += course_var[k]
+        p[ekf.U, ekf.U] += var[k]
+        p[ekf.PSI, ekf.PSI] += course_var[k]
         out[key] = (states[key][0], p)
     return out
