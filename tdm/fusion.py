@@ -218,7 +218,8 @@ class Fuser:
                                    cfg.face_turn_sensors)
         for target in self.targets:
             x, p = self._estimate(target, weigh)
-            reported_p = reported_covariance(target, x, p, weigh, live, own_position_m, moved, cfg)
+            reported_p = reported_covariance(target, x, p, *self._members(target, weigh), live, own_position_m,
+                                             moved, cfg)
             target.last_x, target.last_t_s, target.radius_m = x, t_s, self._half_length(target, live)
             ais_track = live.get(("ais", target.members.get("ais", -1)))
             target.mmsi = ais_track.mmsi if ais_track is not None else target.mmsi
@@ -344,8 +345,18 @@ class Fuser:
         distance = math.hypot(float(x[0]) - float(own_position_m[0]), float(x[1]) - float(own_position_m[1]))
         return 0.5 * distance * math.radians(beam_deg)
 
+    def _members(self, target: FusedTarget, states) -> tuple[np.ndarray, np.ndarray]:
+        """The target's members' states (K, 6) and covariances (K, 6, 6) as the fusion weighs them: from
+        ``states``, with a velocity its AIS member rules out left out (``ais_velocity_gate_probability``;
+        :func:`tdm.fusion_rules.without_stray_velocities`)."""
+        xs = np.array([states[(s, i)][0] for s, i in target.members.items()])
+        ps = np.array([states[(s, i)][1] for s, i in target.members.items()])
+        if self._velocity_gate is not None and "ais" in target.members and len(xs) > 1:
+            ps = without_stray_velocities(xs, ps, list(target.members).index("ais"), self._velocity_gate)
+        return xs, ps
+
     def _estimate(self, target: FusedTarget, states) -> tuple[np.ndarray, np.ndarray]:
-        """The target's fused state (6,) and covariance (6, 6) from its members' ``states``.
+        """The target's fused state (6,) and covariance (6, 6) from its members' ``states`` (:meth:`_members`).
 
         Within a :meth:`step` (``states`` fixed once the members are checked) a target with the same members
         is fused once: the arrays are shared, not to be changed in place.
@@ -354,11 +365,8 @@ class Fuser:
         key = (id(states), tuple(target.members.items()))
         if memo is not None and key in memo:
             return memo[key]
-        xs = np.array([states[(s, i)][0] for s, i in target.members.items()])
-        ps = np.array([states[(s, i)][1] for s, i in target.members.items()])
-        if self._velocity_gate is not None and "ais" in target.members and len(xs) > 1:
-            ps = without_stray_velocities(xs, ps, list(target.members).index("ais"), self._velocity_gate)
-        out = fuse(xs, ps, self.config.rule, velocity_frame(self.config.fuse_velocity, target.members))
+        out = fuse(*self._members(target, states), self.config.rule,
+                   velocity_frame(self.config.fuse_velocity, target.members))
         if memo is not None:
             memo[key] = out
         return out

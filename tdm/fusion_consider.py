@@ -28,8 +28,8 @@ if TYPE_CHECKING:  # pragma: no cover
 __all__ = ["reported_covariance"]
 
 
-def reported_covariance(target: FusedTarget, x: np.ndarray, p: np.ndarray, states: dict, live: dict,
-                        own_m: np.ndarray | None, moved: set[tuple[str, int]], config: FusionConfig) -> np.ndarray:
+def reported_covariance(target: FusedTarget, x: np.ndarray, p: np.ndarray, xs: np.ndarray, ps: np.ndarray,
+                        live: dict, own_m: np.ndarray | None, moved: set[tuple[str, int]], config: FusionConfig) -> np.ndarray:
     """The target's fused covariance with its members' biases considered.
 
     Parameters
@@ -40,8 +40,11 @@ def reported_covariance(target: FusedTarget, x: np.ndarray, p: np.ndarray, state
         The target's fused state (position east, north, m).
     p : (6, 6) float
         Its fused covariance.
-    states : dict
-        ``(sensor, track id) -> (x (6,), p (6, 6))``: the members' states as the fusion weighed them.
+    xs : (K, 6) float
+        The members' states as the fusion weighed them, in the order of ``target.members``.
+    ps : (K, 6, 6) float
+        Their covariances as the fusion weighed them (a velocity the AIS rules out left out,
+        :meth:`tdm.fusion.Fuser._members`), so that the considered biases go through the fusion's own weights.
     live : dict
         ``(sensor, track id) -> Track``.
     own_m : (2,) float or None
@@ -61,14 +64,12 @@ def reported_covariance(target: FusedTarget, x: np.ndarray, p: np.ndarray, state
         if key[0] == "lidar" and config.consider_lidar_extent:
             v[n] = live[key].extent_var_m2 * np.eye(2)
         elif key[0] == "radar" and config.consider_radar_face:
-            v[n] = face_covariance(target, key in moved, states[key][0], live[key], own_m, config)
+            v[n] = face_covariance(target, key in moved, xs[n], live[key], own_m, config)
     shared = np.array([key[0] in NAV_RELATIVE_SENSORS for key in keys])
     nav = None
     if config.consider_nav_bias and shared.any():
         nav = nav_bias_covariance(x[:2], own_m, config.nav_position_bias_m, config.nav_heading_bias_deg)
     if not np.any(v > 0.0) and (nav is None or not np.any(nav > 0.0)):
         return p
-    xs = np.array([states[k][0] for k in keys])
-    ps = np.array([states[k][1] for k in keys])
     return p + consider_covariance(xs, ps, v, config.rule, nav, shared,
                                    velocity_frame(config.fuse_velocity, target.members))

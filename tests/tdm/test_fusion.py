@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from tdm import ekf
+from tdm import ekf, fusion_rules
 from tdm.fusion import Fuser, FusionConfig, fuse
 from tdm.tracker import Track
 
@@ -386,6 +386,33 @@ def test_the_lidars_near_side_offset_is_reported_in_the_covariance_not_the_state
     (out,) = fuser.step(0.0, {"lidar": [lidar], "radar": [radar]})
     assert out.x[0] == pytest.approx(4.0 * 0.25 / 1.25)
     assert out.p[0, 0] == pytest.approx(1.0 / 1.25 + (9.0 * 0.8 ** 2 if consider else 0.0))
+
+
+def test_a_velocity_the_ais_rules_out_is_left_out_of_the_state_and_of_the_reported_covariance():
+    """An AIS ship going north at 5 m/s and a LiDAR track on it going south (its speed correlated with its east
+    position): the fused course is the AIS's, and the reported covariance is that fusion's (the LiDAR's velocity
+    and its correlations left out) with the LiDAR's near-side offset taken through the same weights, not through
+    the weights of the LiDAR's velocity kept."""
+    config = FusionConfig(consider_nav_bias=False, weigh_extent=False, weigh_hull=False)
+    fuser = Fuser(config)
+    ais = make_track(1, "ais", 0.0, 100.0, var=4.0, mmsi=257000001)
+    ais.x[ekf.U] = 5.0
+    ais.p[ekf.PSI, ekf.PSI], ais.p[ekf.U, ekf.U] = 0.01, 0.04
+    lidar = make_track(2, "lidar", 1.0, 100.0, var=1.0)
+    lidar.x[ekf.PSI], lidar.x[ekf.U] = np.pi, 5.0
+    lidar.p[ekf.PSI, ekf.PSI], lidar.p[ekf.U, ekf.U] = 0.01, 0.04
+    lidar.p[0, ekf.U] = lidar.p[ekf.U, 0] = 0.15  # correlation 0.75
+    lidar.length_m, lidar.extent_sigma_fraction = 10.0, 0.3
+    (out,) = fuser.step(0.0, {"ais": [ais], "lidar": [lidar]})
+    assert out.sources == ["ais", "lidar"]
+    assert out.x[ekf.PSI] == pytest.approx(0.0, abs=1e-6) and out.x[ekf.U] == pytest.approx(5.0, abs=1e-6)
+    xs, ps = np.array([ais.x, lidar.x]), np.array([ais.p, lidar.p])
+    gated = fusion_rules.without_stray_velocities(xs, ps, 0, fuser._velocity_gate)
+    offset_m2 = np.array([0.0, lidar.extent_var_m2])
+    expected = fuse(xs, gated)[1] + fusion_rules.consider_covariance(xs, gated, offset_m2)
+    assert out.p == pytest.approx(expected)
+    kept = fuse(xs, gated)[1] + fusion_rules.consider_covariance(xs, ps, offset_m2)
+    assert not np.allclose(out.p, kept)  # the offset through the weights of the velocity kept differs
 
 
 @pytest.mark.parametrize("across_m, own, smear, absorbed", [
