@@ -55,6 +55,7 @@ from tdm.fusion_classes import STILL_SPEED_FRACTION, VESSEL_SIGMAS, Classifier
 from tdm.fusion_config import FusionConfig
 from tdm.fusion_geometry import _EIGEN_TOLERANCE, FOOTPRINT_SIGMAS, MERGE_SIGMAS, MERGE_SPEED_MPS  # noqa: F401
 from tdm.fusion_geometry import clearly_apart as _clearly_apart
+from tdm.fusion_geometry import inside, within_reach
 from tdm.fusion_geometry import inside_reference as _inside_reference
 from tdm.fusion_geometry import major_variance as _major_variance
 from tdm.fusion_geometry import moves_apart as _moves_apart
@@ -90,6 +91,7 @@ class FusedTarget:
     members: dict[str, int] = field(default_factory=dict)  # sensor -> track id
     absorbed: set = field(default_factory=set)  # (sensor, track id) of extra tracks on this object
     last_x: np.ndarray | None = None  # the last fused state (6,) reported, and its time
+    last_p: np.ndarray | None = None  # its covariance (6, 6)
     last_t_s: float = 0.0
     radius_m: float = 0.0  # its absorbing radius then
     created_s: float = 0.0
@@ -220,7 +222,8 @@ class Fuser:
             x, p = self._estimate(target, weigh)
             reported_p = reported_covariance(target, x, p, *self._members(target, weigh), live, own_position_m,
                                              moved, cfg)
-            target.last_x, target.last_t_s, target.radius_m = x, t_s, self._half_length(target, live)
+            target.last_x, target.last_p, target.last_t_s = x, p, t_s
+            target.radius_m = self._half_length(target, live)
             ais_track = live.get(("ais", target.members.get("ais", -1)))
             target.mmsi = ais_track.mmsi if ais_track is not None else target.mmsi
             heights = [live[(s, i)].height_m for s, i in target.members.items() if s == "lidar"]
@@ -405,29 +408,7 @@ class Fuser:
         return self._ship_half_length(live[("ais", target.members["ais"])].mmsi) if "ais" in target.members \
             else math.nan
 
-    @staticmethod
-    def _inside(state, centre: np.ndarray, half_length_m: float) -> bool:
-        """Whether the track's position lies within ``half_length_m`` plus FOOTPRINT_SIGMAS standard deviations (along
-        its covariance's major axis) of ``centre``.
-
-        Decided on Python floats with the 2 x 2 eigenvalue in closed form when the distance clears the radius by
-        more than their rounding can move either (a generous bound); else as :func:`_inside_reference`, so that
-        every decision is the reference's (tests/tdm/test_fusion.py).
-        """
-        x, p = state
-        a, b, d = float(p[0, 0]), float(p[1, 0]), float(p[1, 1])
-        distance = math.hypot(float(x[0]) - float(centre[0]), float(x[1]) - float(centre[1]))
-        largest = _major_variance(a, b, d)
-        if math.isfinite(largest + distance + half_length_m):
-            radius = half_length_m + FOOTPRINT_SIGMAS * math.sqrt(max(largest, 0.0))
-            # sqrt moves by at most sqrt of what the eigenvalue moves; both eigenvalues are within a few ulp of |P|
-            slack = FOOTPRINT_SIGMAS * math.sqrt(_EIGEN_TOLERANCE * (abs(a) + abs(b) + abs(d))) \
-                + _EIGEN_TOLERANCE * (distance + radius)
-            if distance < radius - slack:
-                return True
-            if distance > radius + slack:
-                return False
-        return _inside_reference(state, centre, half_length_m)
+    _inside = staticmethod(inside)
 
     def _ended_still(self, target: FusedTarget) -> bool:
         """Whether an ended target is looked for where it was for ``revive_still_s``: settled as still (iceberg,
@@ -442,13 +423,12 @@ class Fuser:
             and abs(float(target.last_x[ekf.U])) < STILL_SPEED_FRACTION * self.config.vessel_speed_mps
 
     def _revive(self, state, t_s: float) -> FusedTarget | None:
-        """The recently ended target whose footprint (its last state predicted to ``t_s``) holds ``state``."""
+        """The recently ended target where ``state`` (a new track's) may be: within its footprint about its last
+        state predicted to ``t_s`` (:meth:`_may_be`)."""
         best, best_d = None, np.inf
         for target in self._ended:
-            # a still target is where it was: its last small speed (drift of a noisy track) is not carried on
-            centre = target.last_x if self._ended_still(target) else \
-                ekf.predict_mean(target.last_x, t_s - target.last_t_s)
-            if self._inside(state, centre, target.radius_m):
+            centre, inside = self._may_be(target, state, t_s)
+            if inside:
                 d = float(np.hypot(*(state[0][:2] - centre[:2])))
                 if d < best_d:
                     best, best_d = target, d
@@ -456,6 +436,29 @@ class Fuser:
             self._ended.remove(best)
             best.absorbed = set()
         return best
+
+    def _may_be(self, target: FusedTarget, state, t_s: float) -> tuple[np.ndarray, bool]:
+        """Where an ended target is looked for at ``t_s`` (s), its state (6,), and whether ``state`` lies there.
+
+        A still target (:meth:`_ended_still`) is where it was (its last small speed, a noisy track's drift, is not
+        carried on), and the track must lie within its footprint (:meth:`_inside`). A moving one, with
+        ``revive_spread``, goes on straight at its last course and speed (a turn rate estimated as it was being
+        hidden is the hiding's, not the ship's), and the track's distance from there, less the footprint's radius,
+        must pass the association gate (``gate_probability``) in the sum of the track's covariance and that
+        prediction's (the trackers' motion model; the turn rate's uncertainty kept: it may have turned either
+        way), so that the search widens across its track as the gap grows; without, it goes on at its last turn
+        rate too, and the footprint test is as for a still one.
+        """
+        if self._ended_still(target):
+            return target.last_x, self._inside(state, target.last_x, target.radius_m)
+        dt_s = t_s - target.last_t_s
+        if not self.config.revive_spread or target.last_p is None:
+            centre = ekf.predict_mean(target.last_x, dt_s)
+            return centre, self._inside(state, centre, target.radius_m)
+        straight = target.last_x.copy()
+        straight[ekf.R] = 0.0
+        centre, spread = ekf.predict(straight, target.last_p, dt_s, ekf.ProcessNoise())
+        return centre, within_reach(state, centre, spread, target.radius_m, self._gate)
 
     def _merge_overlapping(self, states, live, own_position_m: np.ndarray | None = None) -> None:
         """Fold a target into an older one when both are the same object.

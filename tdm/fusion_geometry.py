@@ -71,8 +71,58 @@ def major_variance(a: float, b: float, d: float) -> float:
     return 0.5 * (a + d) + math.hypot(0.5 * (a - d), b)
 
 
+def inside(state, centre: np.ndarray, half_length_m: float) -> bool:
+    """Whether the track's position lies within ``half_length_m`` plus FOOTPRINT_SIGMAS standard deviations (along
+    its covariance's major axis) of ``centre``.
+
+    Decided on Python floats with the 2 x 2 eigenvalue in closed form when the distance clears the radius by
+    more than their rounding can move either (a generous bound); else as :func:`inside_reference`, so that
+    every decision is the reference's (tests/tdm/test_fusion.py; :meth:`tdm.fusion.Fuser._inside`).
+    """
+    x, p = state
+    a, b, d = float(p[0, 0]), float(p[1, 0]), float(p[1, 1])
+    distance = math.hypot(float(x[0]) - float(centre[0]), float(x[1]) - float(centre[1]))
+    largest = major_variance(a, b, d)
+    if math.isfinite(largest + distance + half_length_m):
+        radius = half_length_m + FOOTPRINT_SIGMAS * math.sqrt(max(largest, 0.0))
+        # sqrt moves by at most sqrt of what the eigenvalue moves; both eigenvalues are within a few ulp of |P|
+        slack = FOOTPRINT_SIGMAS * math.sqrt(_EIGEN_TOLERANCE * (abs(a) + abs(b) + abs(d))) \
+            + _EIGEN_TOLERANCE * (distance + radius)
+        if distance < radius - slack:
+            return True
+        if distance > radius + slack:
+            return False
+    return inside_reference(state, centre, half_length_m)
+
+
+def within_reach(state, centre: np.ndarray, spread: np.ndarray, half_length_m: float, gate_chi2: float) -> bool:
+    """Whether a track's position may be that of an object predicted to ``centre``: its distance from there, less
+    ``half_length_m`` (the object's footprint), passes ``gate_chi2`` (chi-square, 2 dof) in the sum of the track's
+    position covariance and the prediction's ``spread`` (its (6, 6) or (2, 2) covariance); False where either is
+    not finite.
+
+    Parameters
+    ----------
+    state : tuple of (6,) and (6, 6) float
+        The track's state and covariance (east, north, m first).
+    centre : (2,) or (6,) float
+        The predicted position (east, north, m first).
+    spread : (2, 2) or (6, 6) float
+    half_length_m : float
+    gate_chi2 : float
+    """
+    x, p = state
+    d = np.asarray(x[:2], dtype=float) - np.asarray(centre[:2], dtype=float)
+    distance = float(np.hypot(*d))
+    beyond = d * max(0.0, 1.0 - half_length_m / distance) if distance > 0.0 else d
+    cov = np.asarray(p, dtype=float)[:2, :2] + np.asarray(spread, dtype=float)[:2, :2]
+    if not (np.all(np.isfinite(cov)) and np.all(np.isfinite(beyond))):
+        return False
+    return float(beyond @ np.linalg.solve(cov, beyond)) <= gate_chi2
+
+
 def inside_reference(state, centre: np.ndarray, half_length_m: float) -> bool:
-    """:meth:`Fuser._inside` in numpy operations (LAPACK's eigenvalue): the reference of its fast decision."""
+    """:func:`inside` in numpy operations (LAPACK's eigenvalue): the reference of its fast decision."""
     x, p = state
     sigma = np.sqrt(max(np.linalg.eigvalsh(p[:2, :2])[-1], 0.0))
     return bool(np.hypot(*(x[:2] - centre[:2])) <= half_length_m + FOOTPRINT_SIGMAS * sigma)

@@ -38,6 +38,9 @@ POSITION_DOF = 2
 MIN_TWO_POINT_DT_S = 1e-3
 #: The course is set only when the two-point speed exceeds this many of its standard deviations.
 COURSE_SIGMAS = 2.0
+#: ... and when it tries again from the first detection to a later one (``TrackerConfig.course_retry_s``): each try
+#: is another chance for a still object's scatter to pass, so the bar is higher.
+RETRY_COURSE_SIGMAS = 2.0
 #: Too slow to tell the course: the speed variance is bounded by the two-point variance plus this,
 #: (m/s)^2 ((0.5 m/s)^2).
 SLOW_SPEED_VAR_MARGIN_MPS2 = 0.25
@@ -129,6 +132,7 @@ class Track:
     length_now_m: float = 0.0
     width_m: float = float("nan")
     footprint_width_fraction: float | None = None
+    course_unknown: bool = False
     _last_prediction: tuple | None = field(default=None, init=False, repr=False, compare=False)
 
     def predicted(self, t_s: float) -> tuple[np.ndarray, np.ndarray]:
@@ -329,7 +333,8 @@ class PositionTracker:
 
     def _update(self, track: Track, dets: Detections, j: int, cov_j: np.ndarray) -> None:
         t = float(dets.time_s[j])
-        if track.n_updates == 1 and t - track.t_s > MIN_TWO_POINT_DT_S:
+        if (track.n_updates == 1 or (track.course_unknown and t - track.created_s <= self.config.course_retry_s)) \
+                and t - track.created_s > MIN_TWO_POINT_DT_S:
             self._two_point(track, dets.position_m[j], cov_j, t)
         x, p = track.predicted(t)
         z, r = self._measurement(dets, j, cov_j)
@@ -349,22 +354,29 @@ class PositionTracker:
         self._record(track, self._counted_hit(track, dets, j))
 
     def _two_point(self, track: Track, position_m: np.ndarray, cov_m2: np.ndarray, t_s: float) -> None:
-        """Course and speed of a one-hit track from its first and this detection."""
-        dt = t_s - track.t_s
+        """Course and speed of a track whose course is not known yet from its first and this detection (at its
+        second, and while ``course_retry_s`` allows; :class:`TrackerConfig`)."""
+        dt = t_s - track.created_s
         v = (position_m - track.first_position_m) / dt
         cov_v = (cov_m2 + track.first_cov_m2) / dt**2
         speed = float(np.hypot(*v))
         sigma_speed = float(np.sqrt(np.trace(cov_v) / 2.0))
         x, p = track.x.copy(), track.p.copy()
-        if speed > COURSE_SIGMAS * sigma_speed:
+        if speed > (COURSE_SIGMAS if track.n_updates == 1 else RETRY_COURSE_SIGMAS) * sigma_speed:
             ve, vn = v
             jac = np.array([[vn / speed**2, -ve / speed**2], [ve / speed, vn / speed]])
             polar = jac @ cov_v @ jac.T
             x[ekf.PSI], x[ekf.U] = np.arctan2(ve, vn), speed
-            p[np.ix_([ekf.PSI, ekf.U], [ekf.PSI, ekf.U])] = polar
-        else:
-            # too slow to tell the course yet: keep it unknown, bound the speed
+            vel = [ekf.PSI, ekf.U]
+            p[vel, :] = 0.0  # what the filter inferred of them without a course is replaced
+            p[:, vel] = 0.0
+            p[np.ix_(vel, vel)] = polar
+            track.course_unknown = False
+        elif track.n_updates == 1:
+            # too slow to tell the course yet: keep it unknown, bound the speed (the speed is not yet correlated
+            # with anything: a later try leaves the filter's covariance as it is)
             p[ekf.U, ekf.U] = min(p[ekf.U, ekf.U], sigma_speed**2 + SLOW_SPEED_VAR_MARGIN_MPS2)
+            track.course_unknown = True
         track.x, track.p = x, p
 
     def _initiate(self, dets: Detections, j: int, cov_j: np.ndarray) -> None:

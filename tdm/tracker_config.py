@@ -106,6 +106,14 @@ class TrackerConfig:
         a LiDAR cluster of an object that may go on beyond it) reports this standard deviation more along the line
         of sight from the own ship, m (:func:`tdm.fusion_face.sensor_report`; a consider term as the extent's, not
         in the filter). 0: none.
+    course_retry_s : float
+        A track whose first two detections were too close for their velocity to tell its course (the two-point
+        speed under ``COURSE_SIGMAS`` of its standard deviation) tries again from its first detection to each
+        later one for this long after it started, s, as the velocity's uncertainty falls with the time between
+        them: a 6 m/s ship whose radar plots scatter 5-7 m across the beam moves 15 m between two sweeps, under
+        two standard deviations of that two-point velocity, and a track left with an unknown course and no speed
+        cannot learn either (its position's change with the course is the speed times the time: none), so its
+        plots leave it behind. 0 (default): the second detection only.
     process : ekf.ProcessNoise
     """
 
@@ -133,6 +141,7 @@ class TrackerConfig:
     max_speed_mps: float = 20.0
     extent_sigma_fraction: float = 0.0
     range_cut_sigma_m: float = 0.0
+    course_retry_s: float = 0.0
     footprint_width_fraction: float | None = None
     echo_hold_beam_deg: float | None = None
     echo_hold_range_m: float = 10.0

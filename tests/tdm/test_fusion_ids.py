@@ -49,6 +49,34 @@ def test_a_new_track_where_a_target_just_ended_takes_its_id():
     assert elsewhere.target.target_id not in (first.target.target_id, late.target.target_id)
 
 
+@pytest.mark.parametrize("spread, gap_s, off_m, same", [
+    (True, 45.0, 0.0, True),     # back where it would be, 45 s on
+    (True, 45.0, 40.0, True),    # 40 m off the straight line: within the prediction's spread after 45 s
+    (False, 45.0, 40.0, False),  # the footprint alone (15 m + 3 sd of the new track's 2 m)
+    (True, 45.0, 150.0, True),   # across its track the prediction's spread (193 m after 45 s) is wide
+    (True, 45.0, -250.0, False), # along its track it is not (29 m): another ship, 250 m behind
+    (True, 65.0, 0.0, False),    # past revive_s (60 s)
+])
+def test_a_ship_back_from_hiding_takes_its_id_where_its_last_motion_and_its_uncertainty_put_it(spread, gap_s, off_m,
+                                                                                              same):
+    """A 30 m ship without AIS going east at 6 m/s (its course known to 2 deg, speed to 0.3 m/s, and a turn rate of
+    1 deg/s estimated as it went into hiding: not carried on) is lost behind an island; a new radar track appears
+    ``gap_s`` later where it went on straight, ``off_m`` to the north of there (across its track; negative: that
+    far behind, along its track)."""
+    config = FusionConfig(revive_spread=spread, revive_slow_as_still=False)
+    fuser = Fuser(config)
+    ship = make_track(1, "radar", 0.0, 450.0, var=25.0)
+    ship.x[ekf.PSI], ship.x[ekf.U], ship.x[ekf.R] = np.radians(90.0), 6.0, np.radians(1.0)
+    ship.p[ekf.PSI, ekf.PSI], ship.p[ekf.U, ekf.U] = np.radians(2.0) ** 2, 0.09
+    ship.length_m = 30.0
+    (first,) = fuser.step(0.0, {"radar": [ship]})
+    fuser.step(1.0, {"radar": []})
+    along, across = (off_m, 0.0) if off_m < 0.0 else (0.0, off_m)
+    back = make_track(2, "radar", 6.0 * gap_s + along, 450.0 + across, var=4.0, t=gap_s)
+    (again,) = fuser.step(gap_s, {"radar": [back]})
+    assert (again.target.target_id == first.target.target_id) == same
+
+
 def test_a_still_target_keeps_its_id_when_its_echo_comes_back_minutes_later_where_it_was():
     fuser = Fuser(FusionConfig(revive_s=30.0, revive_still_s=300.0))
     berg = make_track(1, "radar", 800.0, 0.0, var=25.0)
@@ -124,19 +152,19 @@ def test_a_target_taken_back_by_its_second_track_is_no_longer_among_the_ended():
 
 @pytest.mark.parametrize("slow, same_id", [(True, True), (False, False)])
 def test_a_slow_target_that_ended_before_settling_is_looked_for_where_it_was(slow, same_id):
-    """A growler's radar track, still, seen for 5 s (under ``settle_s``: not yet an iceberg) and lost; a minute later
-    (over ``revive_s``, under ``revive_still_s``) a new radar track at its place takes its id with
+    """A growler's radar track, still, seen for 5 s (under ``settle_s``: not yet an iceberg) and lost; a minute and a half
+    later (over ``revive_s``, under ``revive_still_s``) a new radar track at its place takes its id with
     ``revive_slow_as_still``, a new one without. A moving target's id is not kept so long."""
     config = FusionConfig(revive_slow_as_still=slow)
-    assert config.revive_s < 60.0 < config.revive_still_s
+    assert config.revive_s < 90.0 < config.revive_still_s
     fuser = Fuser(config)
     first = make_track(1, "radar", 0.0, 400.0)
     for t in range(5):
         (out,) = fuser.step(float(t), {"radar": [first]})
     assert out.target.descriptor == "unknown"
     assert fuser.step(5.0, {}) == []
-    again = make_track(2, "radar", 2.0, 401.0, t=65.0)
-    (back,) = fuser.step(65.0, {"radar": [again]})
+    again = make_track(2, "radar", 2.0, 401.0, t=95.0)
+    (back,) = fuser.step(95.0, {"radar": [again]})
     assert (back.target.target_id == out.target.target_id) == same_id
     moving = Fuser(config)
     boat = make_track(1, "radar", 0.0, 400.0)
@@ -144,8 +172,8 @@ def test_a_slow_target_that_ended_before_settling_is_looked_for_where_it_was(slo
     for t in range(5):
         (gone,) = moving.step(float(t), {"radar": [boat]})
     moving.step(5.0, {})
-    where = make_track(2, "radar", 0.0, 400.0, t=65.0)  # where it was: a moving target is not looked for there
-    assert moving.step(65.0, {"radar": [where]})[0].target.target_id != gone.target.target_id
+    where = make_track(2, "radar", 0.0, 400.0, t=95.0)  # where it was: a moving target is not looked for there
+    assert moving.step(95.0, {"radar": [where]})[0].target.target_id != gone.target.target_id
 
 
 @pytest.mark.parametrize("on_plot", [True, False])

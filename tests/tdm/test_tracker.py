@@ -343,3 +343,47 @@ def test_a_one_hit_track_beside_a_hull_does_not_push_its_confirmed_track_off_it(
     tracker.process(_plots(5.0, [[0.0, 0.0], [35.0, 0.0]], [25.0, 5.0]), np.zeros(2))
     assert np.hypot(*hull.x[:2]) < 5.0
     assert hull.updated_s == 5.0
+
+
+@pytest.mark.parametrize("retry_s", [0.0, 10.0])
+def test_a_course_too_uncertain_at_two_plots_is_tried_again_from_the_first(retry_s):
+    """A 6 m/s ship going east, plots every 2.5 s on its track with 7 m standard deviation (a radar 450-700 m off).
+    Two plots: the velocity's standard deviation is sqrt((49 + 49) / 2) / 2.5 = 3.96 m/s, 6 m/s under two of them,
+    so the course stays unknown; the first to the third: 1.98 m/s, 6 m/s over two of them. With ``course_retry_s``
+    the track takes the course there and follows the ship; without, its course is never learnt (a track with no
+    speed has no position change to learn it from) and the plots leave it behind."""
+    tracker = PositionTracker("radar", replace(CFG, course_retry_s=retry_s, init_speed_sigma_mps=4.0))
+    track = None
+    for k in range(8):
+        t = 2.5 * k
+        tracker.process(scan(t, [100.0 + 6.0 * t, 450.0], sigma=7.0), np.zeros(2))
+        if k == 1:
+            (track,) = tracker.tracks
+            assert track.course_unknown
+        if k == 2:
+            assert track.course_unknown == (retry_s == 0.0)
+    if retry_s == 0.0:
+        assert track not in tracker.tracks or abs(track.x[ekf.U]) < 3.0
+        return
+    assert tracker.tracks == [track]
+    assert track.x[ekf.U] == pytest.approx(6.0, abs=0.6)  # catching up the lag of its first two plots
+    assert np.degrees(ekf.wrap_pi(track.x[ekf.PSI] - np.pi / 2)) == pytest.approx(0.0, abs=3.0)
+    assert track.x[ekf.E] == pytest.approx(100.0 + 6.0 * 17.5, abs=3.0)
+
+
+def test_a_still_object_tried_again_keeps_an_unknown_course_and_the_filters_covariance():
+    """Plots of a still object, scattered 2 m: no try finds a course, and a later try leaves the filter's
+    covariance as the filter made it (its speed correlated with its position by then: bounding the speed's
+    variance alone, as the second plot does, could leave a matrix that is no covariance)."""
+    rng = np.random.default_rng(4)
+    tracker = PositionTracker("radar", replace(CFG, course_retry_s=10.0, init_speed_sigma_mps=4.0))
+    for k in range(3):
+        tracker.process(scan(2.5 * k, np.array([300.0, 500.0]) + rng.normal(scale=2.0, size=2), sigma=7.0),
+                        np.zeros(2))
+    (track,) = tracker.tracks
+    assert track.course_unknown and abs(track.x[ekf.U]) < 1.5
+    assert np.any(track.p[ekf.U, :2] != 0.0) and track.p[ekf.U, ekf.U] > 0.5
+    before = track.p.copy()
+    tracker._two_point(track, np.array([301.0, 500.0]), 1.0 * np.eye(2), 20.0)  # sd 0.36 m/s: a bound of 0.38 (m/s)^2
+    assert track.course_unknown
+    np.testing.assert_array_equal(track.p, before)
