@@ -29,7 +29,8 @@ __all__ = ["reported_covariance"]
 
 
 def reported_covariance(target: FusedTarget, x: np.ndarray, p: np.ndarray, xs: np.ndarray, ps: np.ndarray,
-                        live: dict, own_m: np.ndarray | None, moved: set[tuple[str, int]], config: FusionConfig) -> np.ndarray:
+                        live: dict, own_m: np.ndarray | None, moved: set[tuple[str, int]],
+                        config: FusionConfig) -> np.ndarray:
     """The target's fused covariance with its members' biases considered.
 
     Parameters
