@@ -53,10 +53,9 @@ from tdm import ekf
 from tdm.association import chi2_gate, gnn, mahalanobis2
 from tdm.fusion_classes import STILL_SPEED_FRACTION, VESSEL_SIGMAS, Classifier
 from tdm.fusion_config import FusionConfig
-from tdm.fusion_geometry import _EIGEN_TOLERANCE, FOOTPRINT_SIGMAS, MERGE_SIGMAS, MERGE_SPEED_MPS  # noqa: F401
+from tdm.fusion_geometry import FOOTPRINT_SIGMAS, MERGE_SIGMAS, MERGE_SPEED_MPS  # noqa: F401
 from tdm.fusion_geometry import clearly_apart as _clearly_apart
 from tdm.fusion_geometry import inside, within_reach
-from tdm.fusion_geometry import inside_reference as _inside_reference
 from tdm.fusion_geometry import major_variance as _major_variance
 from tdm.fusion_geometry import moves_apart as _moves_apart
 from tdm.fusion_consider import reported_covariance
@@ -125,7 +124,7 @@ class Fuser:
         self._velocity_gate = None if config.ais_velocity_gate_probability is None else \
             chi2_gate(config.ais_velocity_gate_probability, VELOCITY_DOF)
         self._classifier = Classifier(config)
-        self._memo: dict | None = None  # the fused estimates of one step (_estimate)
+        self._memo: dict | None = None  # the fused estimates and weighed members of one step (_estimate, _members)
 
     def step(self, t_s: float, tracks_by_sensor: dict[str, list[Track]],
              own_position_m: np.ndarray | None = None,
@@ -351,11 +350,18 @@ class Fuser:
     def _members(self, target: FusedTarget, states) -> tuple[np.ndarray, np.ndarray]:
         """The target's members' states (K, 6) and covariances (K, 6, 6) as the fusion weighs them: from
         ``states``, with a velocity its AIS member rules out left out (``ais_velocity_gate_probability``;
-        :func:`tdm.fusion_rules.without_stray_velocities`)."""
+        :func:`tdm.fusion_rules.without_stray_velocities`). Within a :meth:`step` kept as :meth:`_estimate` keeps
+        its fusion (the fusion and the reported covariance read them both)."""
+        memo = self._memo
+        key = ("members", id(states), tuple(target.members.items()))
+        if memo is not None and key in memo:
+            return memo[key]
         xs = np.array([states[(s, i)][0] for s, i in target.members.items()])
         ps = np.array([states[(s, i)][1] for s, i in target.members.items()])
         if self._velocity_gate is not None and "ais" in target.members and len(xs) > 1:
             ps = without_stray_velocities(xs, ps, list(target.members).index("ais"), self._velocity_gate)
+        if memo is not None:
+            memo[key] = (xs, ps)
         return xs, ps
 
     def _estimate(self, target: FusedTarget, states) -> tuple[np.ndarray, np.ndarray]:

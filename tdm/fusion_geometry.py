@@ -11,6 +11,7 @@ import math
 import numpy as np
 
 from tdm import ekf
+from tdm.association import mahalanobis2
 
 __all__ = ["FOOTPRINT_SIGMAS", "MERGE_SIGMAS", "MERGE_SPEED_MPS", "clearly_apart", "inside_reference", "major_variance",
            "moves_apart"]
@@ -118,7 +119,7 @@ def within_reach(state, centre: np.ndarray, spread: np.ndarray, half_length_m: f
     cov = np.asarray(p, dtype=float)[:2, :2] + np.asarray(spread, dtype=float)[:2, :2]
     if not (np.all(np.isfinite(cov)) and np.all(np.isfinite(beyond))):
         return False
-    return float(beyond @ np.linalg.solve(cov, beyond)) <= gate_chi2
+    return float(mahalanobis2(beyond, cov)) <= gate_chi2
 
 
 def inside_reference(state, centre: np.ndarray, half_length_m: float) -> bool:

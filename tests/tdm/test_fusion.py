@@ -236,7 +236,7 @@ def test_moves_apart_weighs_the_velocity_difference_in_the_targets_own_velocity_
 def test_footprint_test_decides_as_the_reference_also_at_its_edge():
     """Fuser._inside's closed-form decision is the reference's (LAPACK eigenvalue, np.hypot) for random tracks and
     for tracks placed on the footprint's edge to the last bits, where only the reference can tell."""
-    from tdm.fusion import FOOTPRINT_SIGMAS, _inside_reference
+    from tdm.fusion_geometry import FOOTPRINT_SIGMAS, inside_reference as _inside_reference
 
     rng = np.random.default_rng(3)
     n_edge = 0
@@ -259,7 +259,9 @@ def test_footprint_test_decides_as_the_reference_also_at_its_edge():
 def test_targets_found_clearly_apart_all_at_once_are_apart_one_by_one():
     """_clearly_apart (the merge's vectorised first look) is True only where the reference footprint test says
     outside, also for targets placed on each other's footprint edge, and leaves few outside pairs to it."""
-    from tdm.fusion import FOOTPRINT_SIGMAS, _clearly_apart, _inside_reference
+    from tdm.fusion_geometry import FOOTPRINT_SIGMAS
+    from tdm.fusion_geometry import clearly_apart as _clearly_apart
+    from tdm.fusion_geometry import inside_reference as _inside_reference
 
     rng = np.random.default_rng(8)
     n_apart = n_outside = 0
