@@ -182,7 +182,8 @@ class AisTracker:
         """The report's measured states: their rows, values and variances, and the angle rows (COG); with
         ``held_sigma_mps``, the ship holds its position (:meth:`AisTrackerConfig.held_speed_sigma_mps`)."""
         cfg = self.config
-        rows, z, var = [ekf.E, ekf.N], [report.position_m[0], report.position_m[1]], [cfg.position_var_m2] * 2
+        position_var_m2 = cfg.position_var_m2 + report.position_extra_var_m2  # a reference point not placed
+        rows, z, var = [ekf.E, ekf.N], [report.position_m[0], report.position_m[1]], [position_var_m2] * 2
         angle_rows: tuple[int, ...] = ()
         moving = np.isfinite(report.sog_mps) and report.sog_mps > AIS_COG_MIN_SOG_MPS and held_sigma_mps is None
         if np.isfinite(report.cog_deg) and moving:

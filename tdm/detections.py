@@ -122,6 +122,11 @@ class AisReport:
         Navigational status of a Class A report (ITU-R M.1371-5, message 1-3 bits 38-41: 0 under way using
         engine, 1 at anchor, 5 moored, ...); :data:`groundfloor.ais.NAV_STATUS_NOT_DEFINED` (15) for Class B reports, which carry
         none.
+    position_extra_var_m2 : float
+        Variance per axis, m^2, to add to the AIS position noise: where the report's reference point (its GNSS
+        antenna) lies off the hull's centre by an amount or in a direction the static data and the report do
+        not give (:mod:`tdm.frontend.ais_reference`); 0 where ``position_m`` is the centre or no static data say
+        otherwise.
     """
 
     time_s: float
@@ -133,17 +138,27 @@ class AisReport:
     rot_deg_per_min: float
     msg_type: int
     nav_status: int = NAV_STATUS_NOT_DEFINED
+    position_extra_var_m2: float = 0.0
 
 
 @dataclass
 class AisStatic:
-    """Static data of one MMSI (types 5 and 24): name, ship type and dimensions in metres."""
+    """Static data of one MMSI (types 5, 19 and 24): name, ship type and dimensions in metres.
+
+    ``to_bow_m``, ``to_stern_m``, ``to_port_m``, ``to_starboard_m``: the reference point of the reported
+    positions (the GNSS antenna) from the bow, stern, port and starboard sides (ITU-R M.1371-5 dimensions A, B, C,
+    D), as the latest static message gave them (NaN before any; 0 as sent); ``length_m = A + B`` and
+    ``beam_m = C + D`` (NaN where the sum is 0: not available)."""
 
     mmsi: int
     name: str = ""
     ship_type: int = 0
     length_m: float = float("nan")
     beam_m: float = float("nan")
+    to_bow_m: float = float("nan")
+    to_stern_m: float = float("nan")
+    to_port_m: float = float("nan")
+    to_starboard_m: float = float("nan")
 
 
 @dataclass

@@ -31,6 +31,9 @@ starting with ``"ais/nmea: "`` and the line or message is skipped):
   708 deg/min or more.
 * Dimensions: length = to_bow + to_stern, beam = to_port + to_starboard, metres; a sum
   of 0 means not available -> NaN.
+* Reference point: a report's position is its ship's GNSS antenna, which the static data place
+  (A, B, C, D = to_bow, to_stern, to_port, to_starboard); each report is moved to its hull's
+  centre with the static data received before it (:mod:`tdm.frontend.ais_reference`).
 """
 
 from __future__ import annotations
@@ -48,6 +51,7 @@ from groundfloor.ais import NAV_STATUS_NOT_DEFINED
 from groundfloor.units import MPS_PER_KNOT  # docs/reference.md section 1
 from tdm.detections import AisReport, AisStatic, ReadStats
 from tdm.frames import EnuFrame
+from tdm.frontend.ais_reference import centred_reports
 
 __all__ = ["read_ais", "rot_deg_per_min", "MPS_PER_KNOT"]
 
@@ -143,6 +147,8 @@ class _AisDecoder:
         self.stats = stats
         self.rows: list[tuple[float, int, int, float, float, float, float, float, float]] = []
         self.static: dict[int, AisStatic] = {}
+        #: Per MMSI, each static message's dimensions as received: (t_s, A, B, C, D).
+        self.references: dict[int, list[tuple[float, float, float, float, float]]] = {}
         self.pending: dict[tuple, list] = {}  # (fragment count, sequence id, channel) -> [(sentence, time), ...]
 
     def skip(self, what: str, n: int = 1) -> None:
@@ -232,19 +238,22 @@ class _AisDecoder:
             self.skip("message too short for its type skipped")
             return
         if kind in STATIC_TYPES:
-            self._static(msg, kind)
+            self._static(msg, kind, time_unix_s - self.start_time_unix_s)
         if kind in POSITION_TYPES:
             self._position(sentence, msg, kind, time_unix_s)
 
-    def _static(self, msg, kind: int) -> None:
+    def _static(self, msg, kind: int, time_s: float) -> None:
         entry = self.static.setdefault(int(msg.mmsi), AisStatic(int(msg.mmsi)))
         if kind in _NAME_AND_SHIP_TYPES or (kind == 24 and msg.partno == 0):
             entry.name = _text(msg.shipname)
         if kind in _NAME_AND_SHIP_TYPES or (kind == 24 and msg.partno == 1):
             entry.ship_type = int(msg.ship_type or 0)
             if hasattr(msg, "to_bow"):  # a type 24 B of an auxiliary craft has a mothership instead
+                a, b, c, d = (float(v or 0) for v in (msg.to_bow, msg.to_stern, msg.to_port, msg.to_starboard))
                 entry.length_m = _dimension(msg.to_bow, msg.to_stern)
                 entry.beam_m = _dimension(msg.to_port, msg.to_starboard)
+                entry.to_bow_m, entry.to_stern_m, entry.to_port_m, entry.to_starboard_m = a, b, c, d
+                self.references.setdefault(int(msg.mmsi), []).append((time_s, a, b, c, d))
 
     def _position(self, sentence, msg, kind: int, time_unix_s: float) -> None:
         lon, lat = msg.lon, msg.lat
@@ -270,9 +279,10 @@ class _AisDecoder:
         lat = np.array([r[3] for r in rows])
         lon = np.array([r[4] for r in rows])
         east, north = frame.to_enu(lat, lon)
-        return [AisReport(time_s=r[0], mmsi=r[1], position_m=np.array([e, n]), cog_deg=r[5], sog_mps=r[6],
-                          heading_deg=r[7], rot_deg_per_min=r[8], msg_type=r[2], nav_status=r[9])
-                for r, e, n in zip(rows, east, north)]
+        reports = [AisReport(time_s=r[0], mmsi=r[1], position_m=np.array([e, n]), cog_deg=r[5], sog_mps=r[6],
+                             heading_deg=r[7], rot_deg_per_min=r[8], msg_type=r[2], nav_status=r[9])
+                   for r, e, n in zip(rows, east, north)]
+        return centred_reports(reports, self.references)
 
 
 def read_ais(path: Path, frame: EnuFrame, start_time_unix_s: float,
@@ -295,10 +305,12 @@ def read_ais(path: Path, frame: EnuFrame, start_time_unix_s: float,
     reports : list of AisReport
         Types 1/2/3/18/19, sorted by time (stable: file order within a second). ``time_s``
         is the TAG block time minus the start, s (1 s resolution when the receiver writes whole
-        seconds); ``position_m`` (2,) ENU metres; ``sog_mps`` m/s; ``cog_deg``, ``heading_deg``
+        seconds); ``position_m`` (2,) ENU metres, of the hull's centre where the static data
+        received before the report place its reference point (:mod:`tdm.frontend.ais_reference`); ``sog_mps`` m/s; ``cog_deg``, ``heading_deg``
         compass degrees; ``rot_deg_per_min`` (NaN for Class B).
     static : dict of int to AisStatic
-        Name, ship type, length and beam (m) per MMSI, from types 5, 19 and 24.
+        Name, ship type, length and beam (m) and the reference point's dimensions A-D (m) per MMSI,
+        from types 5, 19 and 24 (the latest received).
 
     Notes
     -----
