@@ -150,6 +150,9 @@ class AisTracker:
         self.tracks: dict[int, Track] = {}
         self.static: dict[int, AisStatic] = {}
         self._ids = itertools.count(1)
+        #: MMSIs whose track's position is its hull's centre (a report moved there by its reference point,
+        #: :mod:`tdm.frontend.ais_reference`), not its transponder's antenna.
+        self._centred: set[int] = set()
 
     def confirmed_tracks(self) -> list[Track]:
         """Every live AIS track (an AIS track is confirmed by its first report)."""
@@ -164,7 +167,24 @@ class AisTracker:
         track = self.tracks.get(report.mmsi)
         if track is None or t - track.updated_s > self.config.coast_s:
             self.tracks[report.mmsi] = self._start(report, rows, z, var, noise)
-            return
+            self._centred.discard(report.mmsi)
+        else:
+            self._centre(track, report)
+            self._update(track, report, rows, z, var, angle_rows, held_sigma_mps, noise)
+        if report.centre_offset_m is not None:
+            self._centred.add(report.mmsi)
+
+    def _centre(self, track: Track, report: AisReport) -> None:
+        """The first report moved to its hull's centre moves the track there too: its reports so far were of the
+        antenna (sent before the static data that place it), and the filter would take the step for motion."""
+        if report.centre_offset_m is not None and report.mmsi not in self._centred:
+            track.x = track.x.copy()
+            track.x[[ekf.E, ekf.N]] += report.centre_offset_m
+
+    def _update(self, track: Track, report: AisReport, rows: list[int], z: list[float], var: list[float],
+                angle_rows: tuple[int, ...], held_sigma_mps: float | None, noise: ekf.ProcessNoise) -> None:
+        """A live track updated with its report's measured states."""
+        t = float(report.time_s)
         if held_sigma_mps is None and track.process is not noise:
             # a held ship got under way at some time since its last report: its state starts again from this
             # report, as a new track's would (its id kept); nothing of its held speed carries over

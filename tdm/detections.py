@@ -127,6 +127,9 @@ class AisReport:
         antenna) lies off the hull's centre by an amount or in a direction the static data and the report do
         not give (:mod:`tdm.frontend.ais_reference`); 0 where ``position_m`` is the centre or no static data say
         otherwise.
+    centre_offset_m : (2,) float64 or None
+        East and north, m, by which ``position_m`` was moved from the transponder's reference point to the hull's
+        centre; None where it was not moved.
     """
 
     time_s: float
@@ -139,6 +142,7 @@ class AisReport:
     msg_type: int
     nav_status: int = NAV_STATUS_NOT_DEFINED
     position_extra_var_m2: float = 0.0
+    centre_offset_m: np.ndarray | None = None
 
 
 @dataclass

@@ -96,7 +96,7 @@ def centred_reports(reports: list[AisReport],
     -------
     list of AisReport
         The same reports, in the same order; those moved or made less certain replaced
-        (``position_m`` and ``position_extra_var_m2``).
+        (``position_m``, ``centre_offset_m`` and ``position_extra_var_m2``).
     """
     if not reports or not references:
         return reports
@@ -114,7 +114,9 @@ def centred_reports(reports: list[AisReport],
                                             np.array([r.cog_deg for r in reports], dtype=float),
                                             np.array([r.sog_mps for r in reports], dtype=float), *dims.T)
     out = list(reports)
-    for k in np.flatnonzero(np.any(offset_m != 0.0, axis=1) | (extra_var_m2 > 0.0)):
+    moved = np.any(offset_m != 0.0, axis=1)
+    for k in np.flatnonzero(moved | (extra_var_m2 > 0.0)):
         out[k] = replace(reports[k], position_m=reports[k].position_m + offset_m[k],
-                         position_extra_var_m2=reports[k].position_extra_var_m2 + float(extra_var_m2[k]))
+                         position_extra_var_m2=reports[k].position_extra_var_m2 + float(extra_var_m2[k]),
+                         centre_offset_m=offset_m[k].copy() if moved[k] else None)
     return out

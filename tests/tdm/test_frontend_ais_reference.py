@@ -105,3 +105,20 @@ def test_the_tracker_takes_an_unplaced_reference_point_as_noise():
     var_unplaced = unplaced.tracks[report.mmsi].p[0, 0]
     assert var_plain == pytest.approx(config.position_var_m2)
     assert var_unplaced == pytest.approx(config.position_var_m2 + 800.0)
+
+
+def test_the_first_report_placed_at_the_centre_moves_the_track_there():
+    """A report sent before the static data is of the antenna; the next one, placed 40 m ahead at the centre, moves
+    the track by that much at once, where a filter fed the step would take it for motion and lag."""
+    tracker = AisTracker(AisTrackerConfig())
+    antenna = AisReport(0.0, 257000001, np.array([0.0, 0.0]), 90.0, 5.0, 90.0, 0.0, 1)
+    tracker.process(antenna)
+    centred = AisReport(10.0, 257000001, np.array([50.0 + 40.0, 0.0]), 90.0, 5.0, 90.0, 0.0, 1,
+                        centre_offset_m=np.array([40.0, 0.0]))
+    tracker.process(centred)
+    track = tracker.tracks[257000001]
+    assert track.x[0] == pytest.approx(90.0, abs=0.5)
+    assert track.x[3] == pytest.approx(5.0, abs=0.2)  # the speed is not thrown by the step
+    tracker.process(AisReport(20.0, 257000001, np.array([100.0 + 40.0, 0.0]), 90.0, 5.0, 90.0, 0.0, 1,
+                              centre_offset_m=np.array([40.0, 0.0])))
+    assert tracker.tracks[257000001].x[0] == pytest.approx(140.0, abs=0.5)  # moved once, not again
