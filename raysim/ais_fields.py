@@ -103,19 +103,32 @@ def ais_text(text: str | None, length: int) -> str:
     return "".join(c if c in AIS_CHARS else " " for c in text.upper())[:length].rstrip()
 
 
-def _dimensions(length_m: float, beam_m: float) -> dict:
-    """Reference point (GNSS antenna) amidships on the centre line."""
-    half_l = min(max(int(round(length_m / 2.0)), 0), 511)
-    half_b = min(max(int(round(beam_m / 2.0)), 0), 63)
-    return {"to_bow": half_l, "to_stern": half_l, "to_port": half_b, "to_starboard": half_b}
+#: Largest dimensions the fields hold, m: A and B 9 bits, C and D 6 bits (ITU-R M.1371-5, message 5).
+MAX_TO_BOW_M, MAX_TO_PORT_M = 511, 63
+
+
+def _dimensions(length_m: float, beam_m: float, reference_point_m: tuple[float, float] | None = None) -> dict:
+    """Dimensions A-D of the reference point (the GNSS antenna) from the bow, stern, port and starboard side, whole
+    metres (ITU-R M.1371-5, message 5 "overall dimension/reference for position"): ``reference_point_m`` (to bow,
+    to port), m, or None for amidships on the centre line (A = B, C = D)."""
+    def whole(value_m: float, limit: int) -> int:
+        return min(max(int(round(value_m)), 0), limit)
+
+    if reference_point_m is None:
+        half_l, half_b = whole(length_m / 2.0, MAX_TO_BOW_M), whole(beam_m / 2.0, MAX_TO_PORT_M)
+        return {"to_bow": half_l, "to_stern": half_l, "to_port": half_b, "to_starboard": half_b}
+    to_bow_m, to_port_m = reference_point_m
+    return {"to_bow": whole(to_bow_m, MAX_TO_BOW_M), "to_stern": whole(length_m - to_bow_m, MAX_TO_BOW_M),
+            "to_port": whole(to_port_m, MAX_TO_PORT_M), "to_starboard": whole(beam_m - to_port_m, MAX_TO_PORT_M)}
 
 
 def static_report(mmsi: int, name: str, call_sign: str | None, ship_type: int, length_m: float, beam_m: float,
-                  draught_m: float, destination: str | None) -> dict:
-    """Fields of a type 5 static and voyage related data message (ETA not available)."""
+                  draught_m: float, destination: str | None, reference_point_m: tuple[float, float] | None = None) -> dict:
+    """Fields of a type 5 static and voyage related data message (ETA not available); the reference point as for
+    :func:`_dimensions`."""
     return {"msg_type": 5, "repeat": 0, "mmsi": mmsi, "ais_version": 0, "imo": 0,
             "callsign": ais_text(call_sign, 7), "shipname": ais_text(name, 20), "ship_type": int(ship_type),
-            **_dimensions(length_m, beam_m), "epfd": 1, "month": 0, "day": 0, "hour": 24, "minute": 60,
+            **_dimensions(length_m, beam_m, reference_point_m), "epfd": 1, "month": 0, "day": 0, "hour": 24, "minute": 60,
             "draught": round(min(max(draught_m, 0.0), 25.5), 1), "destination": ais_text(destination, 20), "dte": 0}
 
 
@@ -125,8 +138,9 @@ def unit_serial(mmsi: int) -> int:
 
 
 def static_report_b(mmsi: int, part: int, name: str, call_sign: str | None, ship_type: int, length_m: float,
-                    beam_m: float) -> dict:
-    """Fields of a type 24 static data report, part A (0: name) or B (1: type, vendor ID, call sign, dimensions).
+                    beam_m: float, reference_point_m: tuple[float, float] | None = None) -> dict:
+    """Fields of a type 24 static data report, part A (0: name) or B (1: type, vendor ID, call sign, dimensions; the
+    reference point as for :func:`_dimensions`).
 
     Part B's vendor ID: manufacturer :data:`VENDOR_ID`, unit model :data:`UNIT_MODEL_CODE`, serial
     number :func:`unit_serial` (pyais's ``vendorid``, ``model`` and ``serial`` fields).
@@ -135,4 +149,4 @@ def static_report_b(mmsi: int, part: int, name: str, call_sign: str | None, ship
         return {"msg_type": 24, "repeat": 0, "mmsi": mmsi, "partno": 0, "shipname": ais_text(name, 20)}
     return {"msg_type": 24, "repeat": 0, "mmsi": mmsi, "partno": 1, "ship_type": int(ship_type), "vendorid": VENDOR_ID,
             "model": UNIT_MODEL_CODE, "serial": unit_serial(mmsi), "callsign": ais_text(call_sign, 7),
-            **_dimensions(length_m, beam_m)}
+            **_dimensions(length_m, beam_m, reference_point_m)}

@@ -349,6 +349,10 @@ class ShipAis:
         (), doc="Periods [start, end] (s) with the transponder switched off", check=_periods_check)
     position_offset_m: tuple[float, float] = param(
         (0.0, 0.0), doc="Offset [east, north] added to every reported position, m (a spoofed or misconfigured fix)")
+    reference_point_m: tuple[float, float] | None = param(
+        None, doc="Where the GNSS antenna whose position is reported stands: [from the bow, from the port side], m "
+                  "(ITU-R M.1371-5 dimensions A and C; at most the ship's length and beam)", ge=0, le=500,
+        default_doc="amidships on the centre line")
 
 
 @dataclass(frozen=True, kw_only=True)

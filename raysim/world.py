@@ -129,6 +129,15 @@ class World:
                 raise InputError(self.scenario.source_file or "scenario", where, exc.message) from None
         return self._mesh_cache[key]
 
+    def _check_reference_point(self, ship, length_m: float, beam_m: float, where: str) -> None:
+        """A transponder's reference point must stand on its hull: at most its length from the bow and its beam from
+        the port side (the mesh's extents for a mesh ship)."""
+        point = ship.ais.reference_point_m if ship.ais is not None else None
+        if point is not None and (point[0] > length_m or point[1] > beam_m):
+            raise InputError(self.scenario.source_file or "scenario", where + ".ais.reference_point_m",
+                             f"[{point[0]:g}, {point[1]:g}] m lies off the hull: at most [{length_m:g}, {beam_m:g}] "
+                             f"(length, beam)")
+
     def _waves(self, cfg: WaveMotionConfig, name: str) -> WaveMotion:
         return WaveMotion(
             cfg.roll_amplitude_deg, cfg.roll_period_s, cfg.pitch_amplitude_deg, cfg.pitch_period_s,
@@ -219,6 +228,7 @@ class World:
             mesh = self._mesh_cache[key]
             _, _, height = mesh.extents_above_water_m()
             length, beam = ship.length_m, ship.beam_m
+        self._check_reference_point(ship, length, beam, where)
         return WorldObject(object_id, ship.name, "ship", mesh, ShipMotion(track), length, beam, height, ship.ais, where,
                            mesh.centre_above_water_m())
 

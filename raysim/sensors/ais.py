@@ -42,7 +42,7 @@ from pyais import encode_dict
 from groundfloor.units import KNOTS_PER_MPS
 from raysim.pose import heading_deg_from_yaw
 from raysim.random_streams import stream
-from raysim.recording.jsonl import course_and_speed
+from raysim.recording.jsonl import centre_positions_m, course_and_speed
 from raysim.recording.nmea import tag_block
 from raysim.recording.staging import atomic_path
 from raysim.scenario import AisNoise, Ship, ShipAis
@@ -88,13 +88,28 @@ class AisMessage:
     data: dict
 
 
+def reference_body_m(obj: WorldObject) -> tuple[float, float]:
+    """Where the transponder's GNSS antenna stands in the body frame (x forward, y to port), m: its
+    ``reference_point_m`` (from the bow, from the port side) on the length x beam box about the object's centre
+    (truth.jsonl's centre, :attr:`raysim.world.WorldObject.centre_body_m`), or that centre (amidships on the centre
+    line, as the static data then say: A = B, C = D)."""
+    cx, cy = obj.centre_body_m
+    point = obj.ais.reference_point_m if obj.ais is not None else None
+    if point is None:
+        return float(cx), float(cy)
+    return float(cx + obj.length_m / 2.0 - point[0]), float(cy + obj.beam_m / 2.0 - point[1])
+
+
 def _kinematics(obj: WorldObject, t: np.ndarray) -> dict:
+    """The true motion of the transponder's antenna at times ``t`` (s): position (m, local frame), COG and heading
+    (deg), SOG (kn) and rate of turn (deg/min)."""
     poses = obj.motion.poses(t)
     cog, sog_mps = course_and_speed(obj.motion.velocity_mps(t), poses.yaw_rad)
     heading = heading_deg_from_yaw(poses.yaw_rad)
     rot = np.gradient(np.degrees(np.unwrap(np.radians(heading))), t) * 60.0 if t.size > 1 else np.zeros(t.size)
-    return {"x": poses.position_m[:, 0], "y": poses.position_m[:, 1], "cog_deg": cog, "sog_kn": sog_mps * KNOTS_PER_MPS,
-            "heading_deg": heading, "rot_deg_per_min": rot}
+    x, y = centre_positions_m(poses.position_m, poses.yaw_rad, reference_body_m(obj))
+    return {"x": x, "y": y, "cog_deg": cog, "sog_kn": sog_mps * KNOTS_PER_MPS, "heading_deg": heading,
+            "rot_deg_per_min": rot}
 
 
 def ship_messages(world: World, obj: WorldObject, ship_cfg: Ship) -> list[AisMessage]:
@@ -213,11 +228,12 @@ def _static_reports(cfg: ShipAis, obj: WorldObject, rng: np.random.Generator,
     if cfg.ais_class == "A":
         ship_type = DEFAULT_SHIP_TYPE_CLASS_A if cfg.ship_type is None else cfg.ship_type
         draught = min(DRAUGHT_PER_LENGTH * length, MAX_DRAUGHT_M) if cfg.draught_m is None else cfg.draught_m
-        static = fields.static_report(cfg.mmsi, name, cfg.call_sign, ship_type, length, beam, draught, cfg.destination)
+        static = fields.static_report(cfg.mmsi, name, cfg.call_sign, ship_type, length, beam, draught, cfg.destination,
+                                      cfg.reference_point_m)
         return [(float(ts), static) for ts in static_t]
     ship_type = DEFAULT_SHIP_TYPE_CLASS_B if cfg.ship_type is None else cfg.ship_type
     part_a = fields.static_report_b(cfg.mmsi, 0, name, cfg.call_sign, ship_type, length, beam)
-    part_b = fields.static_report_b(cfg.mmsi, 1, name, cfg.call_sign, ship_type, length, beam)
+    part_b = fields.static_report_b(cfg.mmsi, 1, name, cfg.call_sign, ship_type, length, beam, cfg.reference_point_m)
     return [(float(ts), part_a) for ts in static_t] + [(float(ts + schedule.SLOT_S), part_b) for ts in static_t]
 
 
