@@ -60,6 +60,10 @@ class Detections:
         cover: ``n_cells`` times the spoke step over ``beam_az_deg`` times the sample spacing over
         ``range_resolution_m`` (:func:`tdm.frontend.radar.radar_detections`), the independent looks at the sea a
         clutter plot of its size holds, whatever the sweep's spokes and samples. None for LiDAR.
+    echo_spread_m : (N,) float64 or None
+        For a radar plot, how much further the echo it is a fragment of reaches than the plot, m (plots along one
+        spoke within :attr:`~tdm.frontend.radar_config.RadarFrontEndConfig.echo_gap_m` of each other are one
+        echo; :func:`tdm.frontend.radar_echoes.fragment_spread_m`): 0 for a plot that is its echo. None for LiDAR.
     range_cut : (N,) bool or None
         For a LiDAR cluster, whether its farthest point lies at the sensor's range limit (within
         :attr:`~tdm.frontend.lidar_config.LidarFrontEndConfig.range_cut_margin_m`): its object may go on beyond the
@@ -81,6 +85,7 @@ class Detections:
     strength_db: np.ndarray | None = None
     beam_fill: np.ndarray | None = None
     core_width_m: np.ndarray | None = None
+    echo_spread_m: np.ndarray | None = None
     resolution_cells: np.ndarray | None = None
     range_cut: np.ndarray | None = None
 

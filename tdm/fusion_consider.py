@@ -1,12 +1,13 @@
 """The covariance a fused target reports: its fusion's, with the biases its members' positions carry taken through
 the fusion's weights (:class:`tdm.fusion.Fuser`; :func:`tdm.fusion_rules.consider_covariance`).
 
-Three biases, each a "consider" term (as in the Schmidt-Kalman filter: a slowly changing offset, not noise, kept out
+Four biases, each a "consider" term (as in the Schmidt-Kalman filter: a slowly changing offset, not noise, kept out
 of the fusion's weights and gates and reported):
 
 - a LiDAR track's centre behind the side it sees (``consider_lidar_extent``; :attr:`tdm.tracker.Track.extent_var_m2`
   per axis);
-- a radar track left on the face it paints (``consider_radar_face``; :func:`tdm.fusion_face.face_covariance`);
+- a radar track left on the face it paints (``consider_radar_face``; :func:`tdm.fusion_face.face_covariance`), and
+  one on a fragment of a longer echo (``consider_radar_fragment``; :func:`tdm.fusion_face.fragment_var_m2`);
 - the own ship's navigation bias, one bias shared by every LiDAR and radar member (``consider_nav_bias``;
   :mod:`tdm.nav_bias`).
 """
@@ -18,7 +19,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from tdm.fusion_config import FusionConfig
-from tdm.fusion_face import face_covariance
+from tdm.fusion_face import face_covariance, fragment_var_m2
 from tdm.fusion_rules import consider_covariance, velocity_frame
 from tdm.nav_bias import NAV_RELATIVE_SENSORS, nav_bias_covariance
 
@@ -64,8 +65,11 @@ def reported_covariance(target: FusedTarget, x: np.ndarray, p: np.ndarray, xs: n
     for n, key in enumerate(keys):
         if key[0] == "lidar" and config.consider_lidar_extent:
             v[n] = live[key].extent_var_m2 * np.eye(2)
-        elif key[0] == "radar" and config.consider_radar_face:
-            v[n] = face_covariance(target, key in moved, xs[n], live[key], own_m, config)
+        elif key[0] == "radar":
+            if config.consider_radar_face:
+                v[n] = face_covariance(target, key in moved, xs[n], live[key], own_m, config)
+            if config.consider_radar_fragment:
+                v[n] += fragment_var_m2(live[key]) * np.eye(2)
     shared = np.array([key[0] in NAV_RELATIVE_SENSORS for key in keys])
     nav = None
     if config.consider_nav_bias and shared.any():

@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from tdm.fusion_config import FusionConfig
+from tdm.hull import UNIFORM_VARIANCE_DIVISOR
 from tdm.nav_bias import NAV_RELATIVE_SENSORS, nav_bias_covariance
 from tdm.tracker import Track
 
@@ -110,17 +111,30 @@ def sensor_report(sensor: str, track: Track, t_s: float, own_m: np.ndarray | Non
     """What a track of ``sensor`` reports in ``sensor_tracks.jsonl`` at ``t_s`` (s): its state (6,) and covariance
     (6, 6); a radar track's as :func:`face_report`, another's as :meth:`tdm.tracker.Track.reported`, and with the
     own ship's navigation bias added to a LiDAR or radar track's position covariance (``consider_nav_bias``,
-    :func:`tdm.nav_bias.nav_bias_covariance`; ``own_m`` (2,) m, the own ship's position, None if unknown)."""
+    :func:`tdm.nav_bias.nav_bias_covariance`; ``own_m`` (2,) m, the own ship's position, None if unknown), a LiDAR
+    track's range limit (:func:`range_cut_covariance`) and a radar track's echo fragment
+    (``radar_track_fragment_covariance``, :func:`fragment_var_m2`)."""
     x, p = face_report(track, t_s, own_m, config) if sensor == "radar" else track.reported(t_s)
     nav = config.consider_nav_bias and sensor in NAV_RELATIVE_SENSORS
     cut = track.range_cut and track.range_cut_sigma_m > 0.0
-    if nav or cut:
+    fragment = fragment_var_m2(track) if sensor == "radar" and config.radar_track_fragment_covariance else 0.0
+    if nav or cut or fragment > 0.0:
         p = p.copy()
+    if fragment > 0.0:
+        p[:2, :2] += fragment * np.eye(2)
     if nav:
         p[:2, :2] += nav_bias_covariance(x[:2], own_m, config.nav_position_bias_m, config.nav_heading_bias_deg)
     if cut:
         p[:2, :2] += range_cut_covariance(x[:2], own_m, track.range_cut_sigma_m)
     return x, p
+
+
+def fragment_var_m2(track: Track) -> float:
+    """Variance per axis, m^2, of a radar track's object's centre along the echo its plots are fragments of: its echo
+    spread (:attr:`tdm.tracker.Track.echo_spread_m`) squared over 12, a point anywhere on it; 0 for a track whose
+    plots are their echoes (or a track of another sensor: NaN spread)."""
+    spread_m = track.echo_spread_m
+    return float(spread_m ** 2 / UNIFORM_VARIANCE_DIVISOR) if np.isfinite(spread_m) and spread_m > 0.0 else 0.0
 
 
 def range_cut_covariance(position_m: np.ndarray, own_m: np.ndarray | None, sigma_m: float) -> np.ndarray:

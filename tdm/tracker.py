@@ -105,6 +105,9 @@ class Track:
     core_width_m : float
         Radar tracks: their plots' core width (:attr:`~tdm.detections.Detections.core_width_m`), smoothed as the
         length is, m; NaN for the other sensors.
+    echo_spread_m : float
+        Radar tracks: how much further the echo their plots are fragments of reaches than the plots
+        (:attr:`~tdm.detections.Detections.echo_spread_m`), smoothed as the width is, m; NaN for the other sensors.
     """
 
     track_id: int
@@ -132,6 +135,7 @@ class Track:
     width_m: float = float("nan")
     footprint_width_fraction: float | None = None
     course_unknown: bool = False
+    echo_spread_m: float = float("nan")
     _last_prediction: tuple | None = field(default=None, init=False, repr=False, compare=False)
 
     def predicted(self, t_s: float) -> tuple[np.ndarray, np.ndarray]:
@@ -201,7 +205,8 @@ def _record_shape(track: Track, dets: Detections, j: int) -> None:
     """What detection ``j`` tells the track of its object's shape: whether it lay at the sensor's range limit
     (:attr:`~tdm.detections.Detections.range_cut`), and the footprint over time: the largest length seen (one
     detection counts as at most LENGTH_JUMP times the largest so far, as for the smoothed length), the latest length,
-    and the width smoothed as the length is after its first updates (NaN sizes skipped)."""
+    and the width smoothed as the length is after its first updates (NaN sizes skipped); a radar plot's echo spread
+    (:attr:`~tdm.detections.Detections.echo_spread_m`) smoothed as the width."""
     track.range_cut = dets.range_cut is not None and bool(dets.range_cut[j])
     length_m = float(dets.length_m[j])
     if np.isfinite(length_m):
@@ -211,6 +216,10 @@ def _record_shape(track: Track, dets: Detections, j: int) -> None:
     width_m = float(dets.width_m[j])
     if np.isfinite(width_m):
         track.width_m = width_m if not np.isfinite(track.width_m) else LENGTH_KEEP * track.width_m + LENGTH_GAIN * width_m
+    if dets.echo_spread_m is not None and np.isfinite(dets.echo_spread_m[j]):
+        spread_m = float(dets.echo_spread_m[j])
+        track.echo_spread_m = spread_m if not np.isfinite(track.echo_spread_m) else \
+            LENGTH_KEEP * track.echo_spread_m + LENGTH_GAIN * spread_m
 
 
 def predicted_at(tracks: list[Track], t_s: float) -> list[tuple[np.ndarray, np.ndarray]]:

@@ -98,6 +98,7 @@ from tdm.frontend.radar_config import RadarFrontEndConfig, ca_alpha, mount_from_
 from tdm.frontend.radar_extended import clutter_map_cells
 from tdm.frontend.radar_land import land_blocks
 from tdm.frontend.radar_plots import _runs, fill_gaps, label_plots
+from tdm.frontend.radar_sizes import PlotSizes, orientation_deg, plot_sizes, resolution_cells
 from tdm.land import LandMask
 
 __all__ = ["RadarFrontEndConfig", "beam_integrated_power", "ca_alpha", "cfar_mask", "clutter_map", "fill_gaps",
@@ -106,12 +107,6 @@ __all__ = ["RadarFrontEndConfig", "beam_integrated_power", "ca_alpha", "cfar_mas
 
 #: Variance of a uniform error over a width w is w^2 / 12 (sample spacing, range resolution).
 UNIFORM_VARIANCE_DIVISOR = 12.0
-#: The two-way beam ``exp(-8 ln2 theta^2 / theta3^2)`` is the one-way beam squared: its smear between
-#: two powers is the one-way width over sqrt(2) (:func:`radar_detections`, cross-range extent).
-TWO_WAY = 2.0
-#: The two-way Gaussian beam is down by this many dB at its one-way -3 dB width, ``20 log10(2)``: its width at
-#: ``x`` dB down is ``theta3 sqrt(x / 6.02)`` (:func:`_core_widths`).
-TWO_WAY_HALF_POWER_DB = 20.0 * np.log10(2.0)
 #: Smallest norm of a horizontal beam direction before it is normalised (no division by zero).
 _MIN_DIRECTION_NORM = 1e-12
 #: Cells per block of spokes the detection steps work on at a time (their per-cell arrays stay in cache).
@@ -367,53 +362,6 @@ def _centroids(plots: _Plots, power: np.ndarray, range_m: np.ndarray, azimuth_de
     return plot_range_m, bearing_rel_deg
 
 
-def _extents(plots: _Plots, d_az: np.ndarray, power_max: np.ndarray, power_min: np.ndarray, plot_range_m: np.ndarray,
-             spacing_m: float, n_spokes: int, config: RadarFrontEndConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(m,) range extent Lr (m), cross-range extent Lc (m) and beam fill of each plot, less the smear of
-    the range point-spread and of the beam (:func:`radar_detections`); ``d_az`` (M,) each cell's azimuth from its
-    plot's bearing, deg, ``power_max``, ``power_min`` (m,) each plot's strongest and weakest cell's power."""
-    lab = plots.label
-    spoke_deg = 360.0 / n_spokes
-    az_max, az_min = _label_max_min(d_az, lab, plots.n)
-    extent_az_deg = az_max - az_min + spoke_deg
-    sample_max, sample_min = _label_max_min(plots.sample, lab, plots.n)
-    extent_r_m = (sample_max - sample_min + 1) * spacing_m
-    # log2 of the plot's power ratio, strongest to weakest cell
-    dynamic_log2 = np.log2(np.maximum(power_max / power_min, 1.0))
-    len_r_m = np.maximum(extent_r_m - config.range_resolution_m * np.sqrt(dynamic_log2), spacing_m)
-    beam_smear_deg = config.beam_az_deg * np.sqrt(dynamic_log2 / TWO_WAY)
-    len_c_m = np.maximum(plot_range_m, spacing_m) * np.radians(np.maximum(extent_az_deg - beam_smear_deg, spoke_deg))
-    beam_fill = extent_az_deg / np.maximum(beam_smear_deg, spoke_deg)
-    return len_r_m, len_c_m, beam_fill
-
-
-def _core_widths(plots: _Plots, power: np.ndarray, d_az: np.ndarray, power_max: np.ndarray, plot_range_m: np.ndarray,
-                 n_spokes: int, config: RadarFrontEndConfig) -> np.ndarray:
-    """(m,) cross-range width of each plot's core, m: the azimuth extent of its cells within ``core_db`` of its
-    strongest, less in quadrature the width the two-way Gaussian beam paints down to ``core_db``
-    (``theta3 sqrt(core_db / 6.02)``), times its range; 0 where the core is no wider than the beam. ``d_az`` and
-    ``power_max`` as for :func:`_extents`."""
-    lab = plots.label
-    core = power >= power_max[lab] * 10.0 ** (-config.core_db / 10.0)
-    az_max, az_min = _label_max_min(d_az[core], lab[core], plots.n)
-    core_deg = az_max - az_min + 360.0 / n_spokes
-    beam_deg = config.beam_az_deg * np.sqrt(config.core_db / TWO_WAY_HALF_POWER_DB)
-    return plot_range_m * np.radians(np.sqrt(np.maximum(core_deg ** 2 - beam_deg ** 2, 0.0)))
-
-
-def _label_max_min(values: np.ndarray, lab: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """(n,) largest and (n,) smallest of ``values`` (M,) per label 0..n-1 of ``lab`` (M,), in the values' dtype
-    (``scipy.ndimage.maximum`` / ``minimum``; every label holds a cell)."""
-    if np.issubdtype(values.dtype, np.floating):
-        low, high = np.inf, -np.inf
-    else:
-        low, high = np.iinfo(values.dtype).max, np.iinfo(values.dtype).min
-    largest, smallest = np.full(n, high, dtype=values.dtype), np.full(n, low, dtype=values.dtype)
-    np.maximum.at(largest, lab, values)
-    np.minimum.at(smallest, lab, values)
-    return largest, smallest
-
-
 def _plot_positions(bearing_rel_deg: np.ndarray, plot_range_m: np.ndarray, azimuth_deg: np.ndarray,
                     heading_deg: np.ndarray, time_s: np.ndarray, track: OwnshipTrack, mount: Mount
                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -504,6 +452,8 @@ def radar_detections(sweep: dict, track: OwnshipTrack, mount: Mount, config: Rad
           quadrature; the size of an object the beam does not resolve, which ``Lc`` (taken down to the plot's
           weakest cell) loses in a saturated echo (docs/tdm.md, "Extended objects");
         - ``resolution_cells = n_cells (360 / spokes / beam_az_deg) (dr / res)``: cells in beamwidths x resolutions;
+        - ``echo_spread_m``: how much further the echo a plot is a fragment of reaches than its core
+          (:func:`tdm.frontend.radar_echoes.fragment_spread_m`, ``echo_gap_m``; 0 for a plot alone);
         - ``cross_section_m2 = Lr Lc`` (the visible footprint); ``length_m`` / ``width_m`` the larger
           / smaller; ``orientation_deg`` the plot's bearing when the range extent is the longer,
           else the bearing + 90 deg, mod 180.
@@ -521,40 +471,36 @@ def radar_detections(sweep: dict, track: OwnshipTrack, mount: Mount, config: Rad
                                                                   track, mount, config))
     if plots is None:
         return Detections.empty("radar", scan_time)
-    power = video_power(echo[plots.spoke, plots.sample], config).astype(np.float64)
-    spacing_m = float(np.median(np.diff(range_m))) if n_samples > 1 else _ONE_SAMPLE_SPACING_M
-    plot_range_m, bearing_rel_deg = _centroids(plots, power, range_m, azimuth_deg)
-    d_az = _wrap_deg(azimuth_deg[plots.spoke] - bearing_rel_deg[plots.label])  # each cell's, from its plot's bearing
-    power_max, power_min = _label_max_min(power, plots.label, plots.n)
-    len_r, len_c, beam_fill = _extents(plots, d_az, power_max, power_min, plot_range_m, spacing_m, n_spokes, config)
+    spacing_m, plot_range_m, bearing_rel_deg, size = _plot_measures(plots, echo, range_m, azimuth_deg, config)
+    len_r, len_c = size.len_r_m, size.len_c_m
     t_plot, u, position = _plot_positions(bearing_rel_deg, plot_range_m, azimuth_deg, heading_deg, time_s, track,
                                           mount)
     k = _off_ship(bearing_rel_deg, plot_range_m, mount, config)
     cov = _plot_covariance(plot_range_m, u, len_r, len_c, spacing_m, config)
-    orientation = _orientation_deg(u, len_r, len_c)
+    orientation = orientation_deg(u, len_r, len_c)
     n_cells = np.bincount(plots.label, minlength=plots.n).astype(np.int64)
     return Detections(
         sensor="radar", scan_time_s=scan_time, time_s=t_plot[k], position_m=position[k], position_cov_m2=cov[k],
         cross_section_m2=(len_r * len_c)[k], length_m=np.maximum(len_r, len_c)[k],
         width_m=np.minimum(len_r, len_c)[k], orientation_deg=orientation[k],
         height_m=np.full(int(np.count_nonzero(k)), np.nan), n_cells=n_cells[k], range_m=plot_range_m[k],
-        strength_db=plots.margin_db[k], beam_fill=beam_fill[k],
-        resolution_cells=_resolution_cells(n_cells[k], n_spokes, spacing_m, config),
-        core_width_m=_core_widths(plots, power, d_az, power_max, plot_range_m, n_spokes, config)[k])
+        strength_db=plots.margin_db[k], beam_fill=size.beam_fill[k],
+        resolution_cells=resolution_cells(n_cells[k], n_spokes, spacing_m, config),
+        core_width_m=size.core_width_m[k], echo_spread_m=size.echo_spread_m[k])
 
 
-def _orientation_deg(u: np.ndarray, len_r: np.ndarray, len_c: np.ndarray) -> np.ndarray:
-    """(P,) plots' orientation, deg in [0, 180): the bearing of the line of sight ``u`` (P, 2) (east, north) where the
-    range extent ``len_r`` (P,) is the longer, else that bearing + 90 deg (``len_c`` (P,) the cross-range extent)."""
-    compass = np.degrees(np.arctan2(u[:, 0], u[:, 1]))
-    return np.mod(np.where(len_r >= len_c, compass, compass + 90.0), 180.0)
-
-
-def _resolution_cells(n_cells: np.ndarray, n_spokes: int, spacing_m: float, config: RadarFrontEndConfig
-                      ) -> np.ndarray:
-    """(P,) how many of the radar's resolution cells (a beamwidth by a range resolution) plots of ``n_cells`` (P,)
-    sweep cells cover: ``n_cells (360 / n_spokes / beam_az_deg) (spacing_m / range_resolution_m)``."""
-    return n_cells * (360.0 / n_spokes / config.beam_az_deg) * (spacing_m / config.range_resolution_m)
+def _plot_measures(plots: _Plots, echo: np.ndarray, range_m: np.ndarray, azimuth_deg: np.ndarray,
+                   config: RadarFrontEndConfig) -> tuple[float, np.ndarray, np.ndarray, PlotSizes]:
+    """The sweep's sample spacing (m); each plot's power-weighted range (m) and bearing from the bow (deg) (m,); and
+    its sizes (:func:`tdm.frontend.radar_sizes.plot_sizes`)."""
+    n_spokes, n_samples = echo.shape
+    power = video_power(echo[plots.spoke, plots.sample], config).astype(np.float64)
+    spacing_m = float(np.median(np.diff(range_m))) if n_samples > 1 else _ONE_SAMPLE_SPACING_M
+    plot_range_m, bearing_rel_deg = _centroids(plots, power, range_m, azimuth_deg)
+    d_az = _wrap_deg(azimuth_deg[plots.spoke] - bearing_rel_deg[plots.label])  # each cell's, from its plot's bearing
+    size = plot_sizes(plots.sample, plots.label, plots.n, power, d_az, bearing_rel_deg, plot_range_m, spacing_m,
+                      n_spokes, config)
+    return spacing_m, plot_range_m, bearing_rel_deg, size
 
 
 def _sweep_land_blocks(land: LandMask | None, azimuth_deg: np.ndarray, heading_deg: np.ndarray, time_s: np.ndarray,

@@ -163,6 +163,10 @@ class RadarFrontEndConfig:
         Bearing offsets of the sidelobe region, deg. Default (5.2, 60): from one beamwidth (inside it,
         the two plots are one echo's) to where the two-way pattern (-70 dB) puts even a saturating
         echo under the video floor (docs/radar.md, "Antenna").
+    echo_gap_m : float or None
+        Plots that share a spoke and lie within this of each other along it are fragments of one echo
+        (:mod:`tdm.frontend.radar_echoes`; ``Detections.echo_spread_m``). Default 10 m (four range resolutions, as
+        ``sidelobe_range_gate_m``): further apart, the radar resolves them. None: no plot is a fragment.
     range_scale_m, spokes, samples : float, int, int or None
         The sweep geometry the configuration is for (scenario ``sensors.radar``); when set,
         :func:`radar_detections` checks each sweep against it.
@@ -204,6 +208,7 @@ class RadarFrontEndConfig:
     sidelobe_margin_db: float | None = 10.0
     sidelobe_range_gate_m: float = 10.0
     sidelobe_offset_deg: tuple[float, float] = (5.2, 60.0)
+    echo_gap_m: float | None = 10.0
     range_scale_m: float | None = None
     spokes: int | None = None
     samples: int | None = None

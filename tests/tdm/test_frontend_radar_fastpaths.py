@@ -10,9 +10,11 @@ import pytest
 from scipy import ndimage
 
 from tdm.frontend import radar, radar_cfar, radar_clutter, radar_plots
-from tdm.frontend.radar import (RadarFrontEndConfig, _filled_between_detections, _label_max_min, _label_runs,
+from tdm.frontend.radar import (RadarFrontEndConfig, _filled_between_detections, _label_runs,
                                 _numbered_by_first, _run_cells, _spokes_per_label, beam_integrated_power, cfar_mask,
                                 fill_gaps, video_power)
+
+from tdm.frontend.radar_sizes import label_max_min
 
 from .test_frontend_radar import RANGE_M, SAMPLES
 
@@ -160,6 +162,6 @@ def test_runs_labels_spokes_and_per_label_extremes_equal_the_cell_labels_and_ndi
         assert np.array_equal(_spokes_per_label(runs.label, runs.spoke, n + 1, shape[0]),
                               radar_plots._spokes_per_label(lab, spoke, n + 1, shape[0]))
         for values in (rng.normal(size=flat.size), flat % shape[1]):
-            largest, smallest = _label_max_min(values, lab - 1, n)
+            largest, smallest = label_max_min(values, lab - 1, n)
             assert np.array_equal(largest, ndimage.maximum(values, lab - 1, np.arange(n)))
             assert np.array_equal(smallest, ndimage.minimum(values, lab - 1, np.arange(n)))

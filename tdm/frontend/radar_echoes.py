@@ -1,0 +1,105 @@
+"""Radar plots that are fragments of one echo: how far each may lie from the centre of what painted it.
+
+A long echo seldom stands out of its background in one piece. harbour_approach's 60 m pier, end-on at 550 m, and the
+30 m ship moored beside it paint video that is broken along range by a few samples at level 0 (the deck between its
+faces and fenders returns little): the front end makes 2-6 plots of it a sweep, different ones each sweep, each a few
+metres long, and the tracker one track on each that persists. Each track then reports the small covariance of a small
+echo, while the object's centre lies anywhere along the whole echo, 20-30 m from an end fragment.
+
+So plots whose cells share a spoke and lie within ``gap_m`` of each other along it are taken as fragments of one echo
+(:func:`fragment_spread_m`), and each plot gets the extent of its echo beyond its own: the span over which its object's
+centre may lie from it, which a radar track reports (:func:`tdm.fusion_face.sensor_report`). A plot alone keeps 0.
+The gap, ``RadarFrontEndConfig.echo_gap_m`` (10 m, four range resolutions, as the sidelobe rule's range gate), is
+the radar's, not fitted: two echoes further apart along one spoke are resolved targets.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
+
+__all__ = ["fragment_spread_m"]
+
+
+def _intervals(values: np.ndarray, label: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """(n,) smallest and largest of ``values`` (M,) per label 0..n-1 (every label holds a cell)."""
+    low, high = np.full(n, np.inf), np.full(n, -np.inf)
+    np.minimum.at(low, label, values)
+    np.maximum.at(high, label, values)
+    return low, high
+
+
+def _extents(d_az_deg: np.ndarray, sample: np.ndarray, label: np.ndarray, n: int, bearing_deg: np.ndarray,
+             spacing_m: float, spoke_deg: float) -> tuple[tuple[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]:
+    """Per plot (n,): the centre and half width of its cells' azimuth interval, deg, each cell a spoke wide, and
+    the near and far end of its range interval, m, each sample ``spacing_m`` long."""
+    az_low, az_high = _intervals(d_az_deg, label, n)
+    az_low, az_high = bearing_deg + az_low - spoke_deg / 2.0, bearing_deg + az_high + spoke_deg / 2.0
+    r_low, r_high = _intervals(sample.astype(float), label, n)
+    return ((az_low + az_high) / 2.0, (az_high - az_low) / 2.0), (r_low * spacing_m, (r_high + 1.0) * spacing_m)
+
+
+def fragment_spread_m(d_az_deg: np.ndarray, sample: np.ndarray, label: np.ndarray, n: int, bearing_deg: np.ndarray,
+                      plot_range_m: np.ndarray, spacing_m: float, spoke_deg: float, gap_m: float,
+                      core: np.ndarray | None = None) -> np.ndarray:
+    """How much further the echo a plot is a fragment of reaches than the plot itself, m (module docstring).
+
+    Parameters
+    ----------
+    d_az_deg : (M,) float
+        Each plot cell's azimuth from its plot's bearing, deg (within +-180).
+    sample : (M,) int
+        Each cell's range sample.
+    label : (M,) int
+        Each cell's plot, 0..n-1.
+    n : int
+        Number of plots.
+    bearing_deg : (n,) float
+        Each plot's bearing, deg.
+    plot_range_m : (n,) float
+        Each plot's range, m.
+    spacing_m : float
+        Range sample spacing, m.
+    spoke_deg : float
+        Azimuth step between spokes, deg.
+    gap_m : float
+        Largest gap along a spoke between two plots of one echo, m.
+    core : (M,) bool, optional
+        The cells that measure how far a plot reaches (its core: within some dB of its strongest cell), so that a
+        strong echo's sidelobe arc, joined to its plot, does not stretch the echo; None: every cell. Which plots
+        are one echo is decided on all their cells.
+
+    Returns
+    -------
+    (n,) float
+        Per plot, the larger of its echo's range extent less its own and its echo's cross-range extent less its own
+        (at the plot's range), both over core cells, m; 0 for a plot that is its echo.
+    """
+    if n < 2:
+        return np.zeros(n)
+    az, rng = _extents(d_az_deg, sample, label, n, bearing_deg, spacing_m, spoke_deg)
+    (centre, half), (r_low, r_high) = az, rng
+    apart_deg = np.abs((centre[:, None] - centre[None, :] + 180.0) % 360.0 - 180.0)
+    share_spokes = apart_deg < half[:, None] + half[None, :]
+    range_gap_m = np.maximum(r_low[:, None] - r_high[None, :], r_low[None, :] - r_high[:, None])
+    i, j = np.nonzero(np.triu(share_spokes & (range_gap_m <= gap_m), 1))
+    if i.size == 0:
+        return np.zeros(n)
+    _, echo = connected_components(coo_matrix((np.ones(i.size), (i, j)), shape=(n, n)), directed=False)
+    if core is not None:
+        (centre, half), (r_low, r_high) = _extents(d_az_deg[core], sample[core], label[core], n, bearing_deg,
+                                                   spacing_m, spoke_deg)
+    # the echo's extent: in range over its plots; in azimuth about its first plot's centre (no wrap at north)
+    first = np.full(echo.max() + 1, n)
+    np.minimum.at(first, echo, np.arange(n))
+    rel = (centre - centre[first[echo]] + 180.0) % 360.0 - 180.0
+    e_az_low, e_az_high = np.full(first.size, np.inf), np.full(first.size, -np.inf)
+    np.minimum.at(e_az_low, echo, rel - half)
+    np.maximum.at(e_az_high, echo, rel + half)
+    e_r_low, e_r_high = np.full(first.size, np.inf), np.full(first.size, -np.inf)
+    np.minimum.at(e_r_low, echo, r_low)
+    np.maximum.at(e_r_high, echo, r_high)
+    beyond_range_m = (e_r_high - e_r_low)[echo] - (r_high - r_low)
+    beyond_cross_m = np.radians((e_az_high - e_az_low)[echo] - 2.0 * half) * plot_range_m
+    return np.maximum(np.maximum(beyond_range_m, beyond_cross_m), 0.0)
