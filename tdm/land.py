@@ -29,7 +29,7 @@ from tdm.detections import Detections
 from tdm.frames import EnuFrame
 from tdm.recording.land import ChartLand
 
-__all__ = ["DETECTION_MARGIN_M", "LandMask", "beam_margin_m", "drop_on_land", "on_chart_land"]
+__all__ = ["DETECTION_MARGIN_M", "LandMask", "ashore", "beam_margin_m", "drop_on_land", "on_chart_land"]
 
 #: Band around the land that counts as land for detections, m: one range resolution cell of the radar
 #: front end (2.5 m, :class:`tdm.frontend.radar_config.RadarFrontEndConfig`). Measured on a 10 s
@@ -122,15 +122,23 @@ def drop_on_land(detections: Detections, mask: LandMask | None, beam_fraction: f
     """
     if mask is None or len(detections) == 0:
         return detections
-    east, north = detections.position_m[:, 0], detections.position_m[:, 1]
-    keep = ~mask.contains(east, north)
-    if beam_fraction > 0.0 and keep.any():
-        margin = beam_margin_m(detections.range_m, beam_fraction, beam_az_deg)
-        near = np.flatnonzero(keep & (margin > 0.0))
+    keep = ~ashore(mask, detections.position_m, detections.range_m, beam_fraction, beam_az_deg)
+    return detections if keep.all() else detections.subset(keep)
+
+
+def ashore(mask: LandMask, position_m: np.ndarray, range_m: np.ndarray, beam_fraction: float = 0.0,
+           beam_az_deg: float = 0.0) -> np.ndarray:
+    """(N,) bool: which detections at ``position_m`` (N, 2) (east, north, m) and ``range_m`` (N,) (m) lie in ``mask``
+    or, with ``beam_fraction`` > 0, within :func:`beam_margin_m` of it (:func:`drop_on_land`)."""
+    east, north = position_m[:, 0], position_m[:, 1]
+    out = np.array(mask.contains(east, north), dtype=bool)
+    if beam_fraction > 0.0 and not out.all():
+        margin = beam_margin_m(range_m, beam_fraction, beam_az_deg)
+        near = np.flatnonzero(~out & (margin > 0.0))
         if near.size:
             distance = shapely.distance(mask.geometry, shapely.points(east[near], north[near]))
-            keep[near[distance <= margin[near]]] = False
-    return detections if keep.all() else detections.subset(keep)
+            out[near[distance <= margin[near]]] = True
+    return out
 
 
 def on_chart_land(land: ChartLand | None, lat_deg, lon_deg) -> np.ndarray:

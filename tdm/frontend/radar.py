@@ -98,8 +98,8 @@ from tdm.frontend.radar_config import RadarFrontEndConfig, ca_alpha, mount_from_
 from tdm.frontend.radar_extended import clutter_map_cells
 from tdm.frontend.radar_land import land_blocks
 from tdm.frontend.radar_plots import _runs, fill_gaps, label_plots
-from tdm.frontend.radar_sizes import PlotSizes, orientation_deg, plot_sizes, resolution_cells
-from tdm.land import LandMask
+from tdm.frontend.radar_sizes import orientation_deg, plot_sizes, resolution_cells
+from tdm.land import LandMask, ashore
 
 __all__ = ["RadarFrontEndConfig", "beam_integrated_power", "ca_alpha", "cfar_mask", "clutter_map", "fill_gaps",
            "label_plots", "mount_from_scenario", "os_alpha", "radar_detections", "training_table", "video_power",
@@ -471,10 +471,12 @@ def radar_detections(sweep: dict, track: OwnshipTrack, mount: Mount, config: Rad
                                                                   track, mount, config))
     if plots is None:
         return Detections.empty("radar", scan_time)
-    spacing_m, plot_range_m, bearing_rel_deg, size = _plot_measures(plots, echo, range_m, azimuth_deg, config)
-    len_r, len_c = size.len_r_m, size.len_c_m
+    spacing_m, plot_range_m, bearing_rel_deg, power, d_az = _plot_measures(plots, echo, range_m, azimuth_deg, config)
     t_plot, u, position = _plot_positions(bearing_rel_deg, plot_range_m, azimuth_deg, heading_deg, time_s, track,
                                           mount)
+    size = plot_sizes(plots.sample, plots.label, plots.n, power, d_az, bearing_rel_deg, plot_range_m, spacing_m,
+                      n_spokes, config, _off_land(land, position, plot_range_m, config))
+    len_r, len_c = size.len_r_m, size.len_c_m
     k = _off_ship(bearing_rel_deg, plot_range_m, mount, config)
     cov = _plot_covariance(plot_range_m, u, len_r, len_c, spacing_m, config)
     orientation = orientation_deg(u, len_r, len_c)
@@ -490,17 +492,24 @@ def radar_detections(sweep: dict, track: OwnshipTrack, mount: Mount, config: Rad
 
 
 def _plot_measures(plots: _Plots, echo: np.ndarray, range_m: np.ndarray, azimuth_deg: np.ndarray,
-                   config: RadarFrontEndConfig) -> tuple[float, np.ndarray, np.ndarray, PlotSizes]:
-    """The sweep's sample spacing (m); each plot's power-weighted range (m) and bearing from the bow (deg) (m,); and
-    its sizes (:func:`tdm.frontend.radar_sizes.plot_sizes`)."""
-    n_spokes, n_samples = echo.shape
+                   config: RadarFrontEndConfig) -> tuple[float, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The sweep's sample spacing (m); each plot's power-weighted range (m) and bearing from the bow (deg) (m,); each
+    plot cell's power (linear) and azimuth from its plot's bearing (deg) (M,)."""
+    n_samples = echo.shape[1]
     power = video_power(echo[plots.spoke, plots.sample], config).astype(np.float64)
     spacing_m = float(np.median(np.diff(range_m))) if n_samples > 1 else _ONE_SAMPLE_SPACING_M
     plot_range_m, bearing_rel_deg = _centroids(plots, power, range_m, azimuth_deg)
-    d_az = _wrap_deg(azimuth_deg[plots.spoke] - bearing_rel_deg[plots.label])  # each cell's, from its plot's bearing
-    size = plot_sizes(plots.sample, plots.label, plots.n, power, d_az, bearing_rel_deg, plot_range_m, spacing_m,
-                      n_spokes, config)
-    return spacing_m, plot_range_m, bearing_rel_deg, size
+    d_az = _wrap_deg(azimuth_deg[plots.spoke] - bearing_rel_deg[plots.label])
+    return spacing_m, plot_range_m, bearing_rel_deg, power, d_az
+
+
+def _off_land(land: LandMask | None, position_m: np.ndarray, plot_range_m: np.ndarray,
+              config: RadarFrontEndConfig) -> np.ndarray | None:
+    """(m,) bool: the plots the chart's land will not take (:func:`tdm.land.drop_on_land` with the radar's beam
+    margin), which alone may be fragments of one echo; None without a chart."""
+    if land is None:
+        return None
+    return ~ashore(land, position_m, plot_range_m, config.land_beam_fraction, config.beam_az_deg)
 
 
 def _sweep_land_blocks(land: LandMask | None, azimuth_deg: np.ndarray, heading_deg: np.ndarray, time_s: np.ndarray,

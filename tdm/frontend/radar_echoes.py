@@ -19,7 +19,13 @@ import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
-__all__ = ["fragment_spread_m"]
+__all__ = ["FRAGMENT_DB", "fragment_spread_m"]
+
+#: A plot more than this far under its echo's strongest is a piece of that echo's range sidelobes or skirt, not more
+#: of the object, dB: the FMCW sets' range response has its first sidelobe 31.5 dB down (docs/radar.md, "Receiver"),
+#: and the two-way antenna pattern is 42 dB down at 6 deg (docs/radar.md, "Antenna"); 20 dB keeps the pieces of a
+#: pier or a hull, which paint within about 12 dB of each other (harbour_approach).
+FRAGMENT_DB = 20.0
 
 
 def _intervals(values: np.ndarray, label: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -42,7 +48,8 @@ def _extents(d_az_deg: np.ndarray, sample: np.ndarray, label: np.ndarray, n: int
 
 def fragment_spread_m(d_az_deg: np.ndarray, sample: np.ndarray, label: np.ndarray, n: int, bearing_deg: np.ndarray,
                       plot_range_m: np.ndarray, spacing_m: float, spoke_deg: float, gap_m: float,
-                      core: np.ndarray | None = None) -> np.ndarray:
+                      core: np.ndarray | None = None, peak_power: np.ndarray | None = None,
+                      fragment_db: float = FRAGMENT_DB, joinable: np.ndarray | None = None) -> np.ndarray:
     """How much further the echo a plot is a fragment of reaches than the plot itself, m (module docstring).
 
     Parameters
@@ -69,6 +76,14 @@ def fragment_spread_m(d_az_deg: np.ndarray, sample: np.ndarray, label: np.ndarra
         The cells that measure how far a plot reaches (its core: within some dB of its strongest cell), so that a
         strong echo's sidelobe arc, joined to its plot, does not stretch the echo; None: every cell. Which plots
         are one echo is decided on all their cells.
+    peak_power : (n,) float, optional
+        Each plot's strongest cell's power (linear). Where given, only the plots within ``fragment_db`` of their
+        echo's strongest measure how far the echo reaches: weaker pieces along its spokes are its range sidelobes
+        and skirt (:data:`FRAGMENT_DB`), not more of the object.
+    fragment_db : float
+    joinable : (n,) bool, optional
+        The plots that may be fragments (those the chart's land will not take: a buoy before a skerry is not a piece
+        of the skerry's echo); the others are left out and get 0. None: all.
 
     Returns
     -------
@@ -83,23 +98,41 @@ def fragment_spread_m(d_az_deg: np.ndarray, sample: np.ndarray, label: np.ndarra
     apart_deg = np.abs((centre[:, None] - centre[None, :] + 180.0) % 360.0 - 180.0)
     share_spokes = apart_deg < half[:, None] + half[None, :]
     range_gap_m = np.maximum(r_low[:, None] - r_high[None, :], r_low[None, :] - r_high[:, None])
-    i, j = np.nonzero(np.triu(share_spokes & (range_gap_m <= gap_m), 1))
+    pair = share_spokes & (range_gap_m <= gap_m)
+    if joinable is not None:
+        pair &= joinable[:, None] & joinable[None, :]
+    i, j = np.nonzero(np.triu(pair, 1))
     if i.size == 0:
         return np.zeros(n)
     _, echo = connected_components(coo_matrix((np.ones(i.size), (i, j)), shape=(n, n)), directed=False)
     if core is not None:
         (centre, half), (r_low, r_high) = _extents(d_az_deg[core], sample[core], label[core], n, bearing_deg,
                                                    spacing_m, spoke_deg)
-    # the echo's extent: in range over its plots; in azimuth about its first plot's centre (no wrap at north)
+    strong = np.ones(n, dtype=bool)
+    if peak_power is not None:
+        echo_peak = np.zeros(echo.max() + 1)
+        np.maximum.at(echo_peak, echo, peak_power)
+        strong = peak_power >= echo_peak[echo] * 10.0 ** (-fragment_db / 10.0)
+    return _beyond_m(echo, strong, centre, half, r_low, r_high, plot_range_m)
+
+
+def _beyond_m(echo: np.ndarray, strong: np.ndarray, centre: np.ndarray, half: np.ndarray, r_low: np.ndarray,
+              r_high: np.ndarray, plot_range_m: np.ndarray) -> np.ndarray:
+    """(n,) how much further each plot's echo reaches than the plot, m: the larger of the echo's range extent less the
+    plot's and its azimuth extent less the plot's (at the plot's range), 0 at least. The echo's extents are those of
+    its ``strong`` plots, in range over ``r_low``-``r_high`` (m) and in azimuth over ``centre`` +- ``half`` (deg)
+    about its first plot's centre (no wrap at north); ``echo`` (n,) each plot's echo."""
+    n = echo.size
     first = np.full(echo.max() + 1, n)
     np.minimum.at(first, echo, np.arange(n))
     rel = (centre - centre[first[echo]] + 180.0) % 360.0 - 180.0
+    s = np.flatnonzero(strong)
     e_az_low, e_az_high = np.full(first.size, np.inf), np.full(first.size, -np.inf)
-    np.minimum.at(e_az_low, echo, rel - half)
-    np.maximum.at(e_az_high, echo, rel + half)
+    np.minimum.at(e_az_low, echo[s], (rel - half)[s])
+    np.maximum.at(e_az_high, echo[s], (rel + half)[s])
     e_r_low, e_r_high = np.full(first.size, np.inf), np.full(first.size, -np.inf)
-    np.minimum.at(e_r_low, echo, r_low)
-    np.maximum.at(e_r_high, echo, r_high)
+    np.minimum.at(e_r_low, echo[s], r_low[s])
+    np.maximum.at(e_r_high, echo[s], r_high[s])
     beyond_range_m = (e_r_high - e_r_low)[echo] - (r_high - r_low)
     beyond_cross_m = np.radians((e_az_high - e_az_low)[echo] - 2.0 * half) * plot_range_m
     return np.maximum(np.maximum(beyond_range_m, beyond_cross_m), 0.0)

@@ -37,15 +37,17 @@ class PlotSizes:
 
 def plot_sizes(sample: np.ndarray, label: np.ndarray, n: int, power: np.ndarray, d_az: np.ndarray,
                bearing_deg: np.ndarray, plot_range_m: np.ndarray, spacing_m: float, n_spokes: int,
-               config: RadarFrontEndConfig) -> PlotSizes:
+               config: RadarFrontEndConfig, joinable: np.ndarray | None = None) -> PlotSizes:
     """Every size measure of a sweep's ``n`` plots (module docstring for the cell arrays; ``bearing_deg`` (n,) and
-    ``plot_range_m`` (n,) each plot's, ``spacing_m`` the sample spacing, ``n_spokes`` the sweep's spokes)."""
+    ``plot_range_m`` (n,) each plot's, ``spacing_m`` the sample spacing, ``n_spokes`` the sweep's spokes;
+    ``joinable`` (n,) bool the plots that may be fragments of one echo, None: all)."""
     power_max, power_min = label_max_min(power, label, n)
     core = power >= power_max[label] * 10.0 ** (-config.core_db / 10.0)  # within core_db of its plot's strongest
     len_r, len_c, beam_fill = _extents(sample, label, n, d_az, power_max, power_min, plot_range_m, spacing_m,
                                        n_spokes, config)
     spread = np.zeros(n) if config.echo_gap_m is None else fragment_spread_m(
-        d_az, sample, label, n, bearing_deg, plot_range_m, spacing_m, 360.0 / n_spokes, config.echo_gap_m, core)
+        d_az, sample, label, n, bearing_deg, plot_range_m, spacing_m, 360.0 / n_spokes, config.echo_gap_m, core,
+        power_max, joinable=joinable)
     return PlotSizes(len_r, len_c, beam_fill, _core_widths(label, n, core, d_az, plot_range_m, n_spokes, config),
                      spread)
 

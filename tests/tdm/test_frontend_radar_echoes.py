@@ -50,6 +50,19 @@ def test_plots_further_apart_than_the_gap_are_resolved_targets():
     assert fragment_spread_m(*args, gap_m=20.0) == pytest.approx([25.0, 25.0])
 
 
+def test_a_piece_far_weaker_than_its_echo_does_not_stretch_it_and_land_is_no_fragment():
+    # a strong 10 m plot with a weak 10 m piece 5 m behind it (its range skirt, 30 dB down) and a third 5 m further
+    args = _plots((0, 10, 100, 10), (0, 10, 115, 10), (0, 10, 130, 10))
+    peak = np.array([1e5, 1e2, 1e5])  # linear power: the middle piece 30 dB under the others
+    spread = fragment_spread_m(*args, gap_m=10.0, peak_power=peak)
+    assert spread == pytest.approx([30.0, 30.0, 30.0])  # the strong two span 40 m; the weak piece lies inside that
+    alone = fragment_spread_m(*_plots((0, 10, 100, 10), (0, 10, 115, 10)), gap_m=10.0, peak_power=peak[:2])
+    assert alone == pytest.approx([0.0, 0.0])  # a skirt does not make its echo longer
+    # the third plot on the chart's land: not a piece of the others' echo (nor they of its)
+    spread = fragment_spread_m(*args, gap_m=10.0, joinable=np.array([True, True, False]))
+    assert spread == pytest.approx([15.0, 15.0, 0.0])
+
+
 def test_the_echo_reaches_across_the_beam_as_far_as_its_widest_fragment():
     # a 20-spoke (10 deg) plot and a 4-spoke one behind it on its middle spokes: the small one's echo is 8 deg wider
     args = _plots((0, 20, 100, 10), (8, 4, 112, 5))
