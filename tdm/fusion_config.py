@@ -121,7 +121,7 @@ class FusionConfig:
     radar_track_fragment_covariance: bool = True
     # the same term through the fusion's weights in each fused target's covariance: tried, not on. On busy_open_sea
     # seeds 1-4 and 7 the fused NEES in its interval fell on every seed (0.926-0.941 -> 0.916-0.936): its fused
-    # targets are more often under their interval (docs/tdm.md)
+    # targets are more often under their interval (docs/tdm.md, "Consistent per-sensor covariances")
     consider_radar_fragment: bool = False
     # a new radar track that joins no target is absorbed by a target within half the radar's cross-range
     # resolution (this beamwidth at its range) as well as within the target's footprint: the radar cannot
