@@ -88,7 +88,7 @@ def test_fitted_k_shape_follows_wards_relation_with_range_and_look_direction():
     x = []
     for k in range(8):  # 6.5 s apart: new key frames, the tile moved on
         clutter, _ = sc.render(k, np.full(spokes, 6.5 * k), rot, pos, az, np.zeros(spokes), h, np.full(spokes, np.inf))
-        x.append(clutter / mean)
+        x.append(np.divide(clutter, mean, out=np.zeros_like(clutter, dtype=float), where=mean > 0))  # no mean: no cell
     x = np.stack(x)
     psi = rp.grazing_angle_deg(4.0, rng)
     area = rp.clutter_cell_area_m2(rng, psi, sc.beam_eq_rad, sc.cell_m)
