@@ -30,14 +30,13 @@ from dataclasses import replace
 import numpy as np
 
 from tdm.detections import AisReport
+from tdm.hull import UNIFORM_VARIANCE_DIVISOR
 
 __all__ = ["COG_AS_HEADING_MIN_SOG_MPS", "centre_offsets", "centred_reports"]
 
 #: Lowest SOG at which a report's COG stands in for its missing true heading, m/s (about 2 kn: a ship making way
 #: heads within a few degrees of its course, a drifting one need not).
 COG_AS_HEADING_MIN_SOG_MPS = 1.0
-#: Variance of a point uniform over a length L, per L^2.
-_UNIFORM_PER_LENGTH2 = 1.0 / 12.0
 
 
 def centre_offsets(heading_deg: np.ndarray, cog_deg: np.ndarray, sog_mps: np.ndarray, to_bow_m: np.ndarray,
@@ -68,7 +67,8 @@ def centre_offsets(heading_deg: np.ndarray, cog_deg: np.ndarray, sog_mps: np.nda
         point_known = given & ~point_unknown
         forward_m = np.where(point_known & (a + b > 0.0), (a - b) / 2.0, 0.0)
         port_m = np.where(point_known & (c + d > 0.0), (c - d) / 2.0, 0.0)
-        cog_ok = np.isfinite(np.asarray(cog_deg, dtype=float)) & (np.asarray(sog_mps, dtype=float) >= COG_AS_HEADING_MIN_SOG_MPS)
+        cog_ok = np.isfinite(np.asarray(cog_deg, dtype=float)) \
+            & (np.asarray(sog_mps, dtype=float) >= COG_AS_HEADING_MIN_SOG_MPS)
     heading = np.where(np.isfinite(heading_deg), heading_deg, np.where(cog_ok, cog_deg, np.nan))
     psi = np.radians(heading)
     along = np.stack([np.sin(psi), np.cos(psi)], axis=-1)  # compass heading -> (east, north)
@@ -76,7 +76,8 @@ def centre_offsets(heading_deg: np.ndarray, cog_deg: np.ndarray, sog_mps: np.nda
     steered = np.isfinite(heading)
     offset_m = np.where(steered[:, None], forward_m[:, None] * along + port_m[:, None] * to_port, 0.0)
     extra_var_m2 = np.where(steered, 0.0, (forward_m ** 2 + port_m ** 2) / 2.0)
-    hull_var_m2 = np.where(point_unknown, (np.nan_to_num(b) ** 2 + np.nan_to_num(d) ** 2) * _UNIFORM_PER_LENGTH2 / 2.0, 0.0)
+    hull_var_m2 = np.where(point_unknown,
+                           (np.nan_to_num(b) ** 2 + np.nan_to_num(d) ** 2) / UNIFORM_VARIANCE_DIVISOR / 2.0, 0.0)
     return offset_m, extra_var_m2 + hull_var_m2
 
 

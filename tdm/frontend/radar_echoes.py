@@ -19,6 +19,8 @@ import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
+from tdm.frontend.radar_plots import label_max_min
+
 __all__ = ["FRAGMENT_DB", "fragment_spread_m"]
 
 #: A plot more than this far under its echo's strongest is a piece of that echo's range sidelobes or skirt, not more
@@ -28,21 +30,13 @@ __all__ = ["FRAGMENT_DB", "fragment_spread_m"]
 FRAGMENT_DB = 20.0
 
 
-def _intervals(values: np.ndarray, label: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """(n,) smallest and largest of ``values`` (M,) per label 0..n-1 (every label holds a cell)."""
-    low, high = np.full(n, np.inf), np.full(n, -np.inf)
-    np.minimum.at(low, label, values)
-    np.maximum.at(high, label, values)
-    return low, high
-
-
 def _extents(d_az_deg: np.ndarray, sample: np.ndarray, label: np.ndarray, n: int, bearing_deg: np.ndarray,
              spacing_m: float, spoke_deg: float) -> tuple[tuple[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]:
     """Per plot (n,): the centre and half width of its cells' azimuth interval, deg, each cell a spoke wide, and
     the near and far end of its range interval, m, each sample ``spacing_m`` long."""
-    az_low, az_high = _intervals(d_az_deg, label, n)
+    az_high, az_low = label_max_min(d_az_deg, label, n)
     az_low, az_high = bearing_deg + az_low - spoke_deg / 2.0, bearing_deg + az_high + spoke_deg / 2.0
-    r_low, r_high = _intervals(sample.astype(float), label, n)
+    r_high, r_low = label_max_min(sample.astype(float), label, n)
     return ((az_low + az_high) / 2.0, (az_high - az_low) / 2.0), (r_low * spacing_m, (r_high + 1.0) * spacing_m)
 
 

@@ -8,7 +8,7 @@ import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
-__all__ = ["fill_gaps", "label_plots"]
+__all__ = ["fill_gaps", "label_max_min", "label_plots"]
 
 
 def _fill_runs(flat: np.ndarray, n_samples: int, detected: np.ndarray) -> np.ndarray:
@@ -129,3 +129,16 @@ def _spokes_per_label(lab: np.ndarray, spoke: np.ndarray, n_labels: int, n_spoke
     new[1:] = (spoke[1:] != spoke[:-1]) | (lab[1:] != lab[:-1])
     pair = np.unique(lab[new].astype(np.int64) * n_spokes + spoke[new])
     return np.bincount(pair // n_spokes, minlength=n_labels)
+
+
+def label_max_min(values: np.ndarray, lab: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """(n,) largest and (n,) smallest of ``values`` (M,) per label 0..n-1 of ``lab`` (M,), in the values' dtype
+    (``scipy.ndimage.maximum`` / ``minimum``; every label holds a cell)."""
+    if np.issubdtype(values.dtype, np.floating):
+        low, high = np.inf, -np.inf
+    else:
+        low, high = np.iinfo(values.dtype).max, np.iinfo(values.dtype).min
+    largest, smallest = np.full(n, high, dtype=values.dtype), np.full(n, low, dtype=values.dtype)
+    np.maximum.at(largest, lab, values)
+    np.minimum.at(smallest, lab, values)
+    return largest, smallest

@@ -13,8 +13,9 @@ import numpy as np
 
 from tdm.frontend.radar_config import RadarFrontEndConfig
 from tdm.frontend.radar_echoes import fragment_spread_m
+from tdm.frontend.radar_plots import label_max_min
 
-__all__ = ["PlotSizes", "label_max_min", "orientation_deg", "plot_sizes", "resolution_cells"]
+__all__ = ["PlotSizes", "orientation_deg", "plot_sizes", "resolution_cells"]
 
 #: The two-way beam ``exp(-8 ln2 theta^2 / theta3^2)`` is the one-way beam squared: its smear between
 #: two powers is the one-way width over sqrt(2) (cross-range extent).
@@ -80,19 +81,6 @@ def _core_widths(label: np.ndarray, n: int, core: np.ndarray, d_az: np.ndarray, 
     core_deg = az_max - az_min + 360.0 / n_spokes
     beam_deg = config.beam_az_deg * np.sqrt(config.core_db / TWO_WAY_HALF_POWER_DB)
     return plot_range_m * np.radians(np.sqrt(np.maximum(core_deg ** 2 - beam_deg ** 2, 0.0)))
-
-
-def label_max_min(values: np.ndarray, lab: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """(n,) largest and (n,) smallest of ``values`` (M,) per label 0..n-1 of ``lab`` (M,), in the values' dtype
-    (``scipy.ndimage.maximum`` / ``minimum``; every label holds a cell)."""
-    if np.issubdtype(values.dtype, np.floating):
-        low, high = np.inf, -np.inf
-    else:
-        low, high = np.iinfo(values.dtype).max, np.iinfo(values.dtype).min
-    largest, smallest = np.full(n, high, dtype=values.dtype), np.full(n, low, dtype=values.dtype)
-    np.maximum.at(largest, lab, values)
-    np.minimum.at(smallest, lab, values)
-    return largest, smallest
 
 
 def orientation_deg(u: np.ndarray, len_r: np.ndarray, len_c: np.ndarray) -> np.ndarray:

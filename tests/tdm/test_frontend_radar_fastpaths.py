@@ -14,7 +14,7 @@ from tdm.frontend.radar import (RadarFrontEndConfig, _filled_between_detections,
                                 _numbered_by_first, _run_cells, _spokes_per_label, beam_integrated_power, cfar_mask,
                                 fill_gaps, video_power)
 
-from tdm.frontend.radar_sizes import label_max_min
+from tdm.frontend.radar_plots import label_max_min
 
 from .test_frontend_radar import RANGE_M, SAMPLES
 
