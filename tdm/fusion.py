@@ -125,6 +125,7 @@ class Fuser:
             chi2_gate(config.ais_velocity_gate_probability, VELOCITY_DOF)
         self._classifier = Classifier(config)
         self._memo: dict | None = None  # the fused estimates and weighed members of one step (_estimate, _members)
+        self.weighed: dict = {}  # (sensor, track id) -> (x (6,), p (6, 6)) as the last step's output fusion weighed it
 
     def step(self, t_s: float, tracks_by_sensor: dict[str, list[Track]],
              own_position_m: np.ndarray | None = None,
@@ -217,6 +218,7 @@ class Fuser:
         if cfg.face_turn_scale > 0.0 and own_position_m is not None and own_velocity_mps is not None:
             weigh = with_face_turn(weigh, live, own_position_m, own_velocity_mps, cfg.face_turn_scale,
                                    cfg.face_turn_sensors)
+        self.weighed = weigh
         for target in self.targets:
             x, p = self._estimate(target, weigh)
             reported_p = reported_covariance(target, x, p, *self._members(target, weigh), live, own_position_m,
@@ -375,7 +377,7 @@ class Fuser:
         if memo is not None and key in memo:
             return memo[key]
         out = fuse(*self._members(target, states), self.config.rule,
-                   velocity_frame(self.config.fuse_velocity, target.members))
+                   velocity_frame(self.config.fuse_velocity, target.members), self.config.fuse_position_apart)
         if memo is not None:
             memo[key] = out
         return out
@@ -578,8 +580,8 @@ class Fuser:
                 break
             xs = np.array([states[k][0] for k in others])
             ps = np.array([states[k][1] for k in others])
-            x, p = fuse(xs, ps, self.config.rule,
-                        velocity_frame(self.config.fuse_velocity, [k[0] for k in others]))
+            frame = velocity_frame(self.config.fuse_velocity, [k[0] for k in others])
+            x, p = fuse(xs, ps, self.config.rule, frame, self.config.fuse_position_apart)
             xi, pi_ = states[key]
             d = xi[:2] - x[:2]
             if self._released(d, pi_[:2, :2] + p[:2, :2]):

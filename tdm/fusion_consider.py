@@ -77,4 +77,4 @@ def reported_covariance(target: FusedTarget, x: np.ndarray, p: np.ndarray, xs: n
     if not np.any(v > 0.0) and (nav is None or not np.any(nav > 0.0)):
         return p
     return p + consider_covariance(xs, ps, v, config.rule, nav, shared,
-                                   velocity_frame(config.fuse_velocity, target.members))
+                                   velocity_frame(config.fuse_velocity, target.members), config.fuse_position_apart)

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from tdm import ekf
+from tdm import ekf, fusion_rules
 from tdm.fusion_rules import from_cartesian, fuse, to_cartesian, velocity_frame, without_stray_velocities
 
 
@@ -88,3 +88,47 @@ def test_a_target_with_ais_fuses_course_and_speed_one_without_east_and_north():
     x_cart, _ = fuse(xs, ps, velocity="cartesian")
     assert math.degrees(x_polar[ekf.PSI]) == pytest.approx(90.0, abs=3.0)
     assert math.cos(x_cart[ekf.PSI] - math.pi / 2) < 0.0 or x_cart[ekf.U] < 0.1
+
+
+def _correlated_estimates():
+    """Two tracks of one object moving north at 5 m/s, their positions 10 m apart (a bias), the same velocity; each
+    filter's position and speed correlated (a track that lies ahead has gained speed)."""
+    xs = np.array([[0.0, 0.0, 0.0, 5.0, 0.0, 10.0], [0.0, 10.0, 0.0, 5.0, 0.0, 10.0]])
+    p1 = np.diag([4.0, 4.0, 0.01, 1.0, 1e-4, 100.0])
+    p1[ekf.N, ekf.U] = p1[ekf.U, ekf.N] = 1.6  # correlation 0.8
+    p2 = np.diag([4.0, 9.0, 0.01, 0.5, 1e-4, 100.0])
+    p2[ekf.N, ekf.U] = p2[ekf.U, ekf.N] = 1.5
+    return xs, np.array([p1, p2])
+
+
+@pytest.mark.parametrize("velocity", ["polar", "cartesian"])
+def test_apart_fusion_keeps_a_position_difference_out_of_the_velocity(velocity):
+    xs, ps = _correlated_estimates()
+    x_whole, _ = fusion_rules.fuse(xs, ps, "simple", velocity)
+    x_apart, p_apart = fusion_rules.fuse(xs, ps, "simple", velocity, apart=True)
+    assert abs(x_whole[ekf.U] - 5.0) > 0.1  # fused as one state, the 10 m turns into speed
+    assert x_apart[ekf.U] == pytest.approx(5.0)
+    assert x_apart[ekf.PSI] == pytest.approx(0.0, abs=1e-12)
+    # the positions fused from their marginals alone: information-weighted north, 1/4 against 1/9
+    assert x_apart[ekf.N] == pytest.approx((0.0 / 4 + 10.0 / 9) / (1 / 4 + 1 / 9))
+    assert p_apart[ekf.N, ekf.N] == pytest.approx(1 / (1 / 4 + 1 / 9))
+    assert np.all(p_apart[:2, 2:] == 0.0)
+
+
+def test_apart_covariances_zero_only_the_position_motion_blocks():
+    _, ps = _correlated_estimates()
+    out = fusion_rules.apart_covariances(ps)
+    assert np.all(out[:, :2, 2:] == 0.0) and np.all(out[:, 2:, :2] == 0.0)
+    assert np.array_equal(out[:, :2, :2], ps[:, :2, :2]) and np.array_equal(out[:, 2:, 2:], ps[:, 2:, 2:])
+    assert ps[0, ekf.N, ekf.U] == 1.6  # the input untouched
+
+
+def test_consider_covariance_follows_the_apart_weights():
+    """A position bias of one estimate reaches only the fused position when the fusion keeps them apart."""
+    xs, ps = _correlated_estimates()
+    bias = np.array([25.0, 0.0])
+    whole = fusion_rules.consider_covariance(xs, ps, bias)
+    apart = fusion_rules.consider_covariance(xs, ps, bias, apart=True)
+    assert whole[ekf.U, ekf.U] > 0.01
+    assert apart[ekf.U, ekf.U] == pytest.approx(0.0, abs=1e-12)
+    assert apart[ekf.N, ekf.N] == pytest.approx(25.0 * ((1 / 4) / (1 / 4 + 1 / 9)) ** 2)
