@@ -1,0 +1,174 @@
+"""Whether the velocities the fusion weighs are as good as their covariances say: velocity NEES per sensor.
+
+Usage::
+
+    python benchmarks/tdm_velocity_consistency.py RECORDING [RECORDING ...] [--whole]
+                                                  [--out benchmarks/results/tdm_velocity_consistency.md]
+
+The evaluation (tdm/evaluate.py) scores positions and their covariances only: ``detected_targets.jsonl`` and
+``sensor_tracks.jsonl`` carry no velocity covariance (docs/formats.md). The fusion, though, weighs each sensor's
+velocity by its covariance (:func:`tdm.fusion_rules.fuse`), so a sensor whose velocity is worse than it says pulls the
+fused course and speed towards its errors. This runs the TDM (default configuration) on each recording and, at every
+output epoch, takes each fused target's members' states as the fusion weighed them (:class:`tdm.fusion.Fuser`, with
+every weight applied) and the fused state, matches each to the nearest truth object within ``MATCH_M`` (the
+evaluation's cut-off), and forms the east-north velocity error ``dv`` and its NEES ``dv^T Q^-1 dv`` (2 dof; ``Q``
+the covariance turned to east and north velocity, :func:`tdm.fusion_rules.to_cartesian`). Per sensor: the mean NEES
+(2 for a consistent one), the fraction in its 95 % interval, the rms velocity error against the median reported
+standard deviation per axis. ``--whole``: each recording a second time with the fusion of the whole state at once
+(``FusionConfig.fuse_position_apart`` off, the rule until 2026-11-29), beside.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
+
+from benchmarks.common import machine_line  # noqa: E402
+from groundfloor.frames import LocalFrame  # noqa: E402
+import tdm.pipeline as pipeline  # noqa: E402
+from tdm.eval_scoring import NEES_95_INTERVAL  # noqa: E402
+from tdm.eval_truth import read_truth_samples  # noqa: E402
+from tdm.fusion import Fuser  # noqa: E402
+from tdm.fusion_rules import to_cartesian  # noqa: E402
+
+#: A state is matched to the nearest truth object within this, m (the evaluation's cut-off, tdm/evaluate.py).
+MATCH_M = 50.0
+SENSORS = ("ais", "lidar", "radar", "fused")
+
+
+class _RecordingFuser(Fuser):
+    """A :class:`Fuser` that keeps, at each step, every member's state as the fusion weighed it and the fused one."""
+
+    rows: list
+
+    def step(self, t_s, tracks_by_sensor, own_position_m=None, own_velocity_mps=None):
+        estimates = super().step(t_s, tracks_by_sensor, own_position_m, own_velocity_mps)
+        for est in estimates:
+            for sensor, track_id in est.target.members.items():
+                x, p = self.weighed[(sensor, track_id)]
+                self.rows.append((t_s, sensor, x, p))
+            self.rows.append((t_s, "fused", est.x, est.p))
+        return estimates
+
+
+def weighed_states(recording: Path, apart: bool = True
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, LocalFrame]:
+    """Run the TDM on ``recording`` (``FusionConfig.fuse_position_apart`` as ``apart``) and return the weighed
+    states: times (R,) s, sensors (R,) str, states (R, 6), covariances (R, 6, 6), in the TDM's frame (returned
+    too)."""
+    rows: list = []
+    frames: list = []
+    fuser_class, tracking_init = pipeline.Fuser, pipeline._Tracking.__init__
+
+    def init(self, *args, **kwargs):
+        tracking_init(self, *args, **kwargs)
+        self.fuser.__class__ = _RecordingFuser
+        self.fuser.rows = rows
+        frames.append(self.ownship.frame)
+
+    pipeline._Tracking.__init__ = init
+    try:
+        with tempfile.TemporaryDirectory() as out:
+            config = pipeline.TdmConfig.for_recording(recording, workers=1)
+            config = dataclasses.replace(config, fusion_config=dataclasses.replace(config.fusion_config,
+                                                                                    fuse_position_apart=apart))
+            pipeline.run_tdm(recording, Path(out), config)
+    finally:
+        pipeline._Tracking.__init__ = tracking_init
+        pipeline.Fuser = fuser_class
+    t = np.array([r[0] for r in rows])
+    return t, np.array([r[1] for r in rows]), np.array([r[2] for r in rows]), np.array([r[3] for r in rows]), frames[0]
+
+
+def _truth_at(truth: dict, names: list, t_s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(R, K, 2) positions and (R, K, 2) velocities east and north of the truth objects ``names`` at ``t_s`` (NaN
+    outside each object's samples)."""
+    pos = np.full((t_s.size, len(names), 2), np.nan)
+    vel = np.full_like(pos, np.nan)
+    for k, name in enumerate(names):
+        sel = truth["name"] == name
+        order = np.argsort(truth["t"][sel])
+        ts = truth["t"][sel][order]
+        cog = np.radians(truth["cog_deg"][sel][order])
+        sog = truth["sog_mps"][sel][order]
+        for col, values in enumerate((truth["east_m"][sel][order], truth["north_m"][sel][order])):
+            pos[:, k, col] = np.interp(t_s, ts, values, left=np.nan, right=np.nan)
+        for col, values in enumerate((sog * np.sin(cog), sog * np.cos(cog))):
+            vel[:, k, col] = np.interp(t_s, ts, values, left=np.nan, right=np.nan)
+    return pos, vel
+
+
+def velocity_nees(recording: Path, apart: bool = True) -> dict[str, dict[str, float]]:
+    """Per sensor (and ``fused``): ``n``, ``nees_mean``, ``in_95``, ``rms_error_mps`` (per axis) and
+    ``reported_sd_mps`` (median, per axis) over the matched weighed states of ``recording`` (``apart``:
+    :func:`weighed_states`)."""
+    t, sensor, x, p, frame = weighed_states(recording, apart)
+    truth, _ = read_truth_samples(recording / "truth.jsonl")
+    own = int(np.flatnonzero(truth["kind"] == "ownship")[0])
+    truth_frame = LocalFrame(truth["lat"][own], truth["lon"][own])
+    truth["east_m"], truth["north_m"] = truth_frame.to_local(truth["lat"], truth["lon"])
+    east, north = truth_frame.to_local(*frame.to_geodetic(x[:, 0], x[:, 1]))
+    names = sorted(set(truth["name"][truth["kind"] != "ownship"].tolist()))
+    pos, vel = _truth_at(truth, names, t)
+    dist = np.hypot(pos[..., 0] - east[:, None], pos[..., 1] - north[:, None])
+    dist = np.where(np.isfinite(dist), dist, np.inf)
+    nearest = np.argmin(dist, axis=1)
+    rows = np.arange(t.size)
+    matched = dist[rows, nearest] <= MATCH_M
+    y, q = to_cartesian(x, p)
+    dv = y[:, 2:4] - vel[rows, nearest]
+    qv = q[:, 2:4, 2:4]
+    value = np.einsum("ni,nij,nj->n", dv, np.linalg.inv(qv), dv)
+    lo, hi = NEES_95_INTERVAL
+    out = {}
+    for name in SENSORS:
+        sel = matched & (sensor == name) & np.isfinite(value)
+        if not sel.any():
+            continue
+        out[name] = {"n": int(sel.sum()), "nees_mean": float(np.mean(value[sel])),
+                     "in_95": float(np.mean((value[sel] >= lo) & (value[sel] <= hi))),
+                     "rms_error_mps": float(np.sqrt(np.mean(dv[sel] ** 2))),
+                     "reported_sd_mps": float(np.median(np.sqrt(np.trace(qv[sel], axis1=1, axis2=2) / 2.0)))}
+    return out
+
+
+def _table(results: dict[str, dict]) -> list[str]:
+    lines = ["| recording | sensor | states | NEES mean (2 consistent) | in 95 % interval | rms error per axis [m/s] "
+             "| reported sd per axis, median [m/s] |", "|---|---|---:|---:|---:|---:|---:|"]
+    for rec, per in results.items():
+        for name, m in per.items():
+            lines.append(f"| {rec} | {name} | {m['n']} | {m['nees_mean']:.2f} | {m['in_95']:.2f} | "
+                         f"{m['rms_error_mps']:.3f} | {m['reported_sd_mps']:.3f} |")
+    return lines
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("recordings", type=Path, nargs="+")
+    parser.add_argument("--whole", action="store_true", help="also with the whole state fused at once")
+    parser.add_argument("--out", type=Path, default=ROOT / "benchmarks/results/tdm_velocity_consistency.md")
+    args = parser.parse_args(argv)
+    results = {}
+    for rec in args.recordings:
+        for apart in (True, False) if args.whole else (True,):
+            name = rec.name if apart else f"{rec.name}, whole state"
+            results[name] = velocity_nees(rec, apart)
+            print(name, {k: round(v["nees_mean"], 2) for k, v in results[name].items()}, flush=True)
+    lines = ["# Velocity consistency per sensor, as the fusion weighs it", "", machine_line(
+        "tdm_velocity_consistency", False), "", "Method: the script's docstring. Default TDM configuration.", "",
+        *_table(results), ""]
+    args.out.write_text("\n".join(lines))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
