@@ -55,12 +55,12 @@ from tdm.fusion_classes import STILL_SPEED_FRACTION, VESSEL_SIGMAS, Classifier
 from tdm.fusion_config import FusionConfig
 from tdm.fusion_geometry import FOOTPRINT_SIGMAS, MERGE_SIGMAS, MERGE_SPEED_MPS  # noqa: F401
 from tdm.fusion_geometry import clearly_apart as _clearly_apart
-from tdm.fusion_geometry import inside, within_reach
+from tdm.fusion_geometry import finite_or_inf, inside, within_reach
 from tdm.fusion_geometry import major_variance as _major_variance
 from tdm.fusion_geometry import moves_apart as _moves_apart
 from tdm.fusion_consider import reported_covariance
 from tdm.fusion_face import STILL_DESCRIPTORS, behind_the_face
-from tdm.fusion_rules import fuse, velocity_frame, without_stray_velocities
+from tdm.fusion_rules import apart_members, fuse, velocity_frame, without_stray_velocities
 from tdm.fusion_weights import member_hull_covariance, with_extent, with_face_turn, with_fragments, with_hull
 from tdm.tracker import Track, predicted_at
 
@@ -75,11 +75,6 @@ RELEASE_GATES = 4
 RELEASE_DISTANCES = 2
 #: The order in which the free tracks of each sensor look for a target: AIS (the identity) first.
 SENSOR_ORDER = ("ais", "lidar", "radar")
-
-
-def _finite_or_inf(value: float) -> float:
-    """``value``, or +inf where it is not finite (NaN sorts nowhere)."""
-    return value if math.isfinite(value) else math.inf
 
 
 @dataclass
@@ -376,8 +371,9 @@ class Fuser:
         key = (id(states), tuple(target.members.items()))
         if memo is not None and key in memo:
             return memo[key]
-        out = fuse(*self._members(target, states), self.config.rule,
-                   velocity_frame(self.config.fuse_velocity, target.members), self.config.fuse_position_apart)
+        cfg = self.config
+        out = fuse(*self._members(target, states), cfg.rule, velocity_frame(cfg.fuse_velocity, target.members),
+                   apart_members(target.members, cfg.fuse_position_apart))
         if memo is not None:
             memo[key] = out
         return out
@@ -394,7 +390,8 @@ class Fuser:
         lengths = [live[(s, i)].length_m for s, i in target.members.items()]
         if target.mmsi is not None:
             lengths.append(self.lengths_by_mmsi.get(target.mmsi, 0.0))
-        out = max(self.config.min_extent_m, self.config.absorb_lengths * max([v for v in lengths if np.isfinite(v)] or [0.0]))
+        finite = [v for v in lengths if np.isfinite(v)]
+        out = max(self.config.min_extent_m, self.config.absorb_lengths * max(finite, default=0.0))
         if memo is not None:
             memo[key] = out
         return out
@@ -573,15 +570,16 @@ class Fuser:
             return
         keys = list(target.members.items())
         if self.config.release_least_precise:  # the widest first: of two that disagree, the better one stays
-            keys.sort(key=lambda k: -_finite_or_inf(float(np.trace(states[k][1][:2, :2]))))
+            keys.sort(key=lambda k: -finite_or_inf(float(np.trace(states[k][1][:2, :2]))))
         for key in keys:
             others = [k for k in target.members.items() if k != key]
             if not others:
                 break
             xs = np.array([states[k][0] for k in others])
             ps = np.array([states[k][1] for k in others])
-            frame = velocity_frame(self.config.fuse_velocity, [k[0] for k in others])
-            x, p = fuse(xs, ps, self.config.rule, frame, self.config.fuse_position_apart)
+            sensors = [k[0] for k in others]
+            x, p = fuse(xs, ps, self.config.rule, velocity_frame(self.config.fuse_velocity, sensors),
+                        apart_members(sensors, self.config.fuse_position_apart))
             xi, pi_ = states[key]
             d = xi[:2] - x[:2]
             if self._released(d, pi_[:2, :2] + p[:2, :2]):

@@ -153,14 +153,12 @@ class FusionConfig:
     # 12.3/6.9/17.8/19.1/7.9 deg, objects where the fusion is no worse than its best sensor on SOG RMSE 8 -> 12 of
     # 30, on all six figures 0 -> 2 (docs/tdm.md, "Fusion")
     fuse_velocity: str = "cartesian_without_ais"
-    # fuse the members' positions and their motions (course, speed, turn rate, size) each from its own marginal
-    # (tdm.fusion_rules.apart_covariances): the tracks' positions carry biases their filters do not model (the side
-    # seen, the part of the hull painted), and fused as one state their position-velocity cross-covariances turn a
-    # position difference into a velocity one. Nothing fitted; busy_open_sea seeds 1-4 and 7 (300 s, tuning): objects
-    # where the fusion is no worse than its best sensor on all six figures 2 -> 6 of 30 (position RMSE 18 -> 27,
-    # median 11 -> 15, COG RMSE 3 -> 6 of 10, SOG RMSE 11 -> 12), median fused error within LiDAR range
-    # 1.90/2.64/1.94/1.93/1.97 -> 2.05/2.69/2.05/1.92/1.99 m (docs/tdm.md, "Fusion"). False: the whole state at once
-    fuse_position_apart: bool = True
+    # the tracks of these sensors enter the fusion as their position's marginal and their motion's (course, speed,
+    # turn rate, size), independent (tdm.fusion_rules.apart_covariances): their positions carry biases their filters do
+    # not model (the side seen, the part of the hull painted), and fused whole their position-velocity
+    # cross-covariances turn a position difference into a velocity one. The AIS's stays whole: between reports its
+    # position's error is its velocity's carried on. Nothing fitted (docs/tdm.md, "Fusion"). (): every track whole
+    fuse_position_apart: tuple[str, ...] = ("lidar", "radar")
     # weigh the velocity of the tracks of these sensors with what their seen side's turning with the line of sight
     # lends it (tdm.fusion_weights.with_face_turn): the side's offset from the centre, scale times its standard
     # deviation (Track.extent_var_m2, the LiDAR's 0.15 of its length), turns at the line of sight's rate. Scale 1:
@@ -203,7 +201,7 @@ class FusionConfig:
         if self.radar_hidden_depth_size not in ("core_width", "length"):
             raise ValueError(f"radar_hidden_depth_size must be 'core_width' or 'length', "
                              f"not {self.radar_hidden_depth_size!r}")
-        for name in ("join_free_slot", "hull_sensors", "fragment_sensors", "face_turn_sensors"):
+        for name in ("join_free_slot", "hull_sensors", "fragment_sensors", "face_turn_sensors", "fuse_position_apart"):
             unknown = sorted(set(getattr(self, name)) - set(TRACK_SENSORS))
             if unknown:
                 raise ValueError(f"{name}: unknown sensor {unknown[0]!r} (one of {', '.join(TRACK_SENSORS)})")

@@ -20,7 +20,7 @@ import numpy as np
 
 from tdm.fusion_config import FusionConfig
 from tdm.fusion_face import face_covariance, fragment_var_m2
-from tdm.fusion_rules import consider_covariance, velocity_frame
+from tdm.fusion_rules import apart_members, consider_covariance, velocity_frame
 from tdm.nav_bias import NAV_RELATIVE_SENSORS, nav_bias_covariance
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -77,4 +77,5 @@ def reported_covariance(target: FusedTarget, x: np.ndarray, p: np.ndarray, xs: n
     if not np.any(v > 0.0) and (nav is None or not np.any(nav > 0.0)):
         return p
     return p + consider_covariance(xs, ps, v, config.rule, nav, shared,
-                                   velocity_frame(config.fuse_velocity, target.members), config.fuse_position_apart)
+                                   velocity_frame(config.fuse_velocity, target.members),
+                                   apart_members(target.members, config.fuse_position_apart))

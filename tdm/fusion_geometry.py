@@ -13,8 +13,8 @@ import numpy as np
 from tdm import ekf
 from tdm.association import mahalanobis2
 
-__all__ = ["FOOTPRINT_SIGMAS", "MERGE_SIGMAS", "MERGE_SPEED_MPS", "clearly_apart", "inside_reference", "major_variance",
-           "moves_apart"]
+__all__ = ["FOOTPRINT_SIGMAS", "MERGE_SIGMAS", "MERGE_SPEED_MPS", "clearly_apart", "finite_or_inf", "inside_reference",
+           "major_variance", "moves_apart"]
 
 #: A track lies inside a target's footprint within its half length plus this many standard deviations
 #: of the track's position (the radar beam smears a ship's ends by tens of metres at range).
@@ -161,3 +161,8 @@ def clearly_apart(estimates: list[tuple[np.ndarray, np.ndarray]], half_lengths_m
     with np.errstate(invalid="ignore"):
         out = distance > radius + 2.0 * slack  # NaN: False
     return np.triu(out, 1)
+
+
+def finite_or_inf(value: float) -> float:
+    """``value``, or +inf where it is not finite (NaN sorts nowhere)."""
+    return value if math.isfinite(value) else math.inf

@@ -132,3 +132,27 @@ def test_consider_covariance_follows_the_apart_weights():
     assert whole[ekf.U, ekf.U] > 0.01
     assert apart[ekf.U, ekf.U] == pytest.approx(0.0, abs=1e-12)
     assert apart[ekf.N, ekf.N] == pytest.approx(25.0 * ((1 / 4) / (1 / 4 + 1 / 9)) ** 2)
+
+
+def test_apart_members_takes_apart_only_the_sensors_named():
+    assert fusion_rules.apart_members({"ais": 1, "lidar": 4, "radar": 2}, ("lidar", "radar")).tolist() == \
+        [False, True, True]
+    _, ps = _correlated_estimates()
+    out = fusion_rules.apart_covariances(ps, np.array([False, True]))
+    assert out[0, ekf.N, ekf.U] == 1.6 and out[1, ekf.N, ekf.U] == 0.0
+    assert fusion_rules.apart_covariances(ps, False) is ps
+
+
+def test_a_whole_estimate_keeps_what_its_cross_covariance_says():
+    """An AIS track coasting since its last report: its position error is its speed's error carried on (the
+    cross-covariance). A second estimate that knows the speed well then narrows the fused position when the first
+    stays whole, and does not when it is taken apart."""
+    coast_s = 60.0
+    x_ais = np.array([0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+    p_ais = np.diag([1.0, 1.0 + coast_s**2 * 0.25, 1.0, 0.25, 1e-4, 100.0])
+    p_ais[ekf.N, ekf.U] = p_ais[ekf.U, ekf.N] = coast_s * 0.25
+    p_radar = np.diag([400.0, 400.0, 1.0, 0.01, 1e-4, 100.0])
+    xs, ps = np.array([x_ais, x_ais]), np.array([p_ais, p_radar])
+    _, p_whole = fusion_rules.fuse(xs, ps, "simple", "polar", apart=np.array([False, True]))
+    _, p_apart = fusion_rules.fuse(xs, ps, "simple", "polar", apart=True)
+    assert p_whole[ekf.N, ekf.N] < 0.3 * p_apart[ekf.N, ekf.N]
