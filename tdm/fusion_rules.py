@@ -147,10 +147,11 @@ def apart_covariances(ps: np.ndarray, which: bool | np.ndarray = True) -> np.nda
     point of a hull its plots paint), and its filter's cross-covariance says how its velocity would move with its
     position's noise, not with that bias: fused as one state, two tracks' positions 10 m apart turn each other's
     velocities by a few tenths of a m/s (busy_open_sea seed 1: a berg's radar track on its face, 10 m from its LiDAR
-    track, put the fused velocity 0.4 m/s off where both tracks' were within 0.1 and 0.3). An AIS track's position
-    error between reports, by contrast, is mostly its velocity's error carried on, which its cross-covariance
-    says: taken apart, a ship at anchor (a report every 3 minutes) lost what the radar's velocity tells of its
-    position (harbour_approach 31: fused NEES in its interval 0.818 -> 0.784), so the AIS's stays whole.
+    track, put the fused east velocity 0.3-0.4 m/s off westward where the LiDAR's erred by under 0.1 and the radar's
+    by 0.2-0.3 eastward). An AIS track's position error between reports, by contrast, is mostly its velocity's error
+    carried on, which its cross-covariance says: taken apart, a ship at anchor (a report every 3 minutes) lost what the
+    radar's velocity tells of its position (harbour_approach 31: fused NEES in its interval 0.818 -> 0.784), so the
+    AIS's stays whole (``FusionConfig.fuse_position_apart``).
     """
     which = np.broadcast_to(np.asarray(which, dtype=bool), np.shape(ps)[:1])
     if not which.any():
