@@ -14,8 +14,8 @@ every weight applied) and the fused state, matches each to the nearest truth obj
 evaluation's cut-off), and forms the east-north velocity error ``dv`` and its NEES ``dv^T Q^-1 dv`` (2 dof; ``Q``
 the covariance turned to east and north velocity, :func:`tdm.fusion_rules.to_cartesian`). Per sensor: the mean NEES
 (2 for a consistent one), the fraction in its 95 % interval, the rms velocity error against the median reported
-standard deviation per axis. ``--whole``: each recording a second time with the fusion of the whole state at once
-(``FusionConfig.fuse_position_apart`` off, the rule until 2026-11-29), beside.
+standard deviation per axis. ``--whole``: each recording a second time with every member fused whole
+(``FusionConfig.fuse_position_apart`` empty, the rule until 2026-11-29), beside.
 """
 
 from __future__ import annotations
@@ -60,11 +60,11 @@ class _RecordingFuser(Fuser):
         return estimates
 
 
-def weighed_states(recording: Path, apart: bool = True
+def weighed_states(recording: Path, whole: bool = False
                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, LocalFrame]:
-    """Run the TDM on ``recording`` (``FusionConfig.fuse_position_apart`` as ``apart``) and return the weighed
-    states: times (R,) s, sensors (R,) str, states (R, 6), covariances (R, 6, 6), in the TDM's frame (returned
-    too)."""
+    """Run the TDM on ``recording`` (``whole``: with ``FusionConfig.fuse_position_apart`` empty) and return the
+    weighed states: times (R,) s, sensors (R,) str, states (R, 6), covariances (R, 6, 6), in the TDM's frame
+    (returned too)."""
     rows: list = []
     frames: list = []
     fuser_class, tracking_init = pipeline.Fuser, pipeline._Tracking.__init__
@@ -79,8 +79,9 @@ def weighed_states(recording: Path, apart: bool = True
     try:
         with tempfile.TemporaryDirectory() as out:
             config = pipeline.TdmConfig.for_recording(recording, workers=1)
-            config = dataclasses.replace(config, fusion_config=dataclasses.replace(config.fusion_config,
-                                                                                    fuse_position_apart=apart))
+            if whole:
+                fusion = dataclasses.replace(config.fusion_config, fuse_position_apart=())
+                config = dataclasses.replace(config, fusion_config=fusion)
             pipeline.run_tdm(recording, Path(out), config)
     finally:
         pipeline._Tracking.__init__ = tracking_init
@@ -107,11 +108,11 @@ def _truth_at(truth: dict, names: list, t_s: np.ndarray) -> tuple[np.ndarray, np
     return pos, vel
 
 
-def velocity_nees(recording: Path, apart: bool = True) -> dict[str, dict[str, float]]:
+def velocity_nees(recording: Path, whole: bool = False) -> dict[str, dict[str, float]]:
     """Per sensor (and ``fused``): ``n``, ``nees_mean``, ``in_95``, ``rms_error_mps`` (per axis) and
-    ``reported_sd_mps`` (median, per axis) over the matched weighed states of ``recording`` (``apart``:
+    ``reported_sd_mps`` (median, per axis) over the matched weighed states of ``recording`` (``whole``:
     :func:`weighed_states`)."""
-    t, sensor, x, p, frame = weighed_states(recording, apart)
+    t, sensor, x, p, frame = weighed_states(recording, whole)
     truth, _ = read_truth_samples(recording / "truth.jsonl")
     own = int(np.flatnonzero(truth["kind"] == "ownship")[0])
     truth_frame = LocalFrame(truth["lat"][own], truth["lon"][own])
@@ -154,14 +155,14 @@ def _table(results: dict[str, dict]) -> list[str]:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("recordings", type=Path, nargs="+")
-    parser.add_argument("--whole", action="store_true", help="also with the whole state fused at once")
+    parser.add_argument("--whole", action="store_true", help="also with every track fused whole")
     parser.add_argument("--out", type=Path, default=ROOT / "benchmarks/results/tdm_velocity_consistency.md")
     args = parser.parse_args(argv)
     results = {}
     for rec in args.recordings:
-        for apart in (True, False) if args.whole else (True,):
-            name = rec.name if apart else f"{rec.name}, whole state"
-            results[name] = velocity_nees(rec, apart)
+        for whole in (False, True) if args.whole else (False,):
+            name = f"{rec.name}, every track whole" if whole else rec.name
+            results[name] = velocity_nees(rec, whole)
             print(name, {k: round(v["nees_mean"], 2) for k, v in results[name].items()}, flush=True)
     lines = ["# Velocity consistency per sensor, as the fusion weighs it", "", machine_line(
         "tdm_velocity_consistency", False), "", "Method: the script's docstring. Default TDM configuration.", "",
