@@ -21,10 +21,10 @@
   differ from the ship's it joins that target; otherwise it starts its own. An AIS ship's absorbed LiDAR
   track becomes its member once it moves with the ship and lies on the hull (``promote_after_s``): the
   LiDAR alone is then often the best position sensor, and an absorbed track is not fused.
-- **Simple Fusion** (thesis eq. 3.2): ``x = (sum_i P_i^-1)^-1 sum_i P_i^-1 x_i`` over the tracks
-  of the target at the output time. It ignores the cross-covariance of the per-sensor tracks,
-  so its covariance is too small (REFERENCE: NEES about 5.8 against 4); ``tdm evaluate``
-  reports the NEES.
+- **Simple Fusion** (thesis eq. 3.2): ``x = (sum_i P_i^-1)^-1 sum_i P_i^-1 x_i`` over the tracks of the target at
+  the output time, a LiDAR or radar track's ``P_i`` without its position-velocity cross-covariance
+  (``fuse_position_apart``). It ignores the cross-covariance of the per-sensor tracks, so its covariance is too
+  small (REFERENCE: NEES about 5.8 against 4); ``tdm evaluate`` reports the NEES.
 - **Where on the hull** (``weigh_hull``): a ship's radar track lies on whatever part of the hull the
   radar paints, so for a target whose AIS gives the ship's length, its radar track enters the output
   fusion with the covariance of a point uniform over the hull added (:func:`tdm.hull.hull_covariance`):
