@@ -64,10 +64,14 @@ def weighed_states(recording: Path, whole: bool = False
                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, LocalFrame]:
     """Run the TDM on ``recording`` (``whole``: with ``FusionConfig.fuse_position_apart`` empty) and return the
     weighed states: times (R,) s, sensors (R,) str, states (R, 6), covariances (R, 6, 6), in the TDM's frame
-    (returned too)."""
+    (returned too).
+
+    The run's fuser is made a :class:`_RecordingFuser` as the pipeline's tracking state is built (the pipeline has
+    no hook for it; its ``_Tracking`` is patched for the run and restored).
+    """
     rows: list = []
     frames: list = []
-    fuser_class, tracking_init = pipeline.Fuser, pipeline._Tracking.__init__
+    tracking_init = pipeline._Tracking.__init__
 
     def init(self, *args, **kwargs):
         tracking_init(self, *args, **kwargs)
@@ -85,7 +89,6 @@ def weighed_states(recording: Path, whole: bool = False
             pipeline.run_tdm(recording, Path(out), config)
     finally:
         pipeline._Tracking.__init__ = tracking_init
-        pipeline.Fuser = fuser_class
     t = np.array([r[0] for r in rows])
     return t, np.array([r[1] for r in rows]), np.array([r[2] for r in rows]), np.array([r[3] for r in rows]), frames[0]
 
