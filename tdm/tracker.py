@@ -213,13 +213,17 @@ def _record_shape(track: Track, dets: Detections, j: int) -> None:
         track.length_now_m = length_m
         track.length_max_m = length_m if track.length_max_m <= 0.0 else \
             max(track.length_max_m, min(length_m, LENGTH_JUMP * track.length_max_m))
-    width_m = float(dets.width_m[j])
-    if np.isfinite(width_m):
-        track.width_m = width_m if not np.isfinite(track.width_m) else LENGTH_KEEP * track.width_m + LENGTH_GAIN * width_m
-    if dets.echo_spread_m is not None and np.isfinite(dets.echo_spread_m[j]):
-        spread_m = float(dets.echo_spread_m[j])
-        track.echo_spread_m = spread_m if not np.isfinite(track.echo_spread_m) else \
-            LENGTH_KEEP * track.echo_spread_m + LENGTH_GAIN * spread_m
+    track.width_m = _moving_mean(track.width_m, float(dets.width_m[j]))
+    if dets.echo_spread_m is not None:
+        track.echo_spread_m = _moving_mean(track.echo_spread_m, float(dets.echo_spread_m[j]))
+
+
+def _moving_mean(old_m: float, new_m: float) -> float:
+    """A size smoothed over a track's detections (LENGTH_KEEP, LENGTH_GAIN), m: ``new_m`` where there is none yet
+    (``old_m`` NaN), ``old_m`` where ``new_m`` is NaN."""
+    if not np.isfinite(new_m):
+        return old_m
+    return new_m if not np.isfinite(old_m) else LENGTH_KEEP * old_m + LENGTH_GAIN * new_m
 
 
 def predicted_at(tracks: list[Track], t_s: float) -> list[tuple[np.ndarray, np.ndarray]]:

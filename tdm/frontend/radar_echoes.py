@@ -121,12 +121,17 @@ def _beyond_m(echo: np.ndarray, strong: np.ndarray, centre: np.ndarray, half: np
     np.minimum.at(first, echo, np.arange(n))
     rel = (centre - centre[first[echo]] + 180.0) % 360.0 - 180.0
     s = np.flatnonzero(strong)
-    e_az_low, e_az_high = np.full(first.size, np.inf), np.full(first.size, -np.inf)
-    np.minimum.at(e_az_low, echo[s], (rel - half)[s])
-    np.maximum.at(e_az_high, echo[s], (rel + half)[s])
-    e_r_low, e_r_high = np.full(first.size, np.inf), np.full(first.size, -np.inf)
-    np.minimum.at(e_r_low, echo[s], r_low[s])
-    np.maximum.at(e_r_high, echo[s], r_high[s])
+    e_az_low, e_az_high = _span((rel - half)[s], (rel + half)[s], echo[s], first.size)
+    e_r_low, e_r_high = _span(r_low[s], r_high[s], echo[s], first.size)
     beyond_range_m = (e_r_high - e_r_low)[echo] - (r_high - r_low)
     beyond_cross_m = np.radians((e_az_high - e_az_low)[echo] - 2.0 * half) * plot_range_m
     return np.maximum(np.maximum(beyond_range_m, beyond_cross_m), 0.0)
+
+
+def _span(low: np.ndarray, high: np.ndarray, group: np.ndarray, m: int) -> tuple[np.ndarray, np.ndarray]:
+    """(m,) smallest of ``low`` (K,) and (m,) largest of ``high`` (K,) per group 0..m-1 of ``group`` (K,)
+    (+inf and -inf for a group without members)."""
+    smallest, largest = np.full(m, np.inf), np.full(m, -np.inf)
+    np.minimum.at(smallest, group, low)
+    np.maximum.at(largest, group, high)
+    return smallest, largest
