@@ -45,7 +45,6 @@ from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -61,6 +60,7 @@ from tdm.fusion_geometry import moves_apart as _moves_apart
 from tdm.fusion_consider import reported_covariance
 from tdm.fusion_face import STILL_DESCRIPTORS, behind_the_face
 from tdm.fusion_rules import apart_members, fuse, velocity_frame, without_stray_velocities
+from tdm.fusion_target import FusedEstimate, FusedTarget
 from tdm.fusion_weights import member_hull_covariance, with_extent, with_face_turn, with_fragments, with_hull
 from tdm.tracker import Track, predicted_at
 
@@ -75,32 +75,6 @@ RELEASE_GATES = 4
 RELEASE_DISTANCES = 2
 #: The order in which the free tracks of each sensor look for a target: AIS (the identity) first.
 SENSOR_ORDER = ("ais", "lidar", "radar")
-
-
-@dataclass
-class FusedTarget:
-    """A detected target: the per-sensor tracks of one object."""
-
-    target_id: int
-    members: dict[str, int] = field(default_factory=dict)  # sensor -> track id
-    absorbed: set = field(default_factory=set)  # (sensor, track id) of extra tracks on this object
-    last_x: np.ndarray | None = None  # the last fused state (6,) reported, and its time
-    last_p: np.ndarray | None = None  # its covariance (6, 6)
-    last_t_s: float = 0.0
-    radius_m: float = 0.0  # its absorbing radius then
-    created_s: float = 0.0
-    descriptor: str = "unknown"
-    mmsi: int | None = None
-
-
-@dataclass
-class FusedEstimate:
-    """A target's fused state at one time."""
-
-    target: FusedTarget
-    x: np.ndarray  # (6,)
-    p: np.ndarray  # (6, 6)
-    sources: list[str]
 
 
 class Fuser:

@@ -14,17 +14,14 @@ of the fusion's weights and gates and reported):
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 
 from tdm.fusion_config import FusionConfig
 from tdm.fusion_face import face_covariance, fragment_var_m2
 from tdm.fusion_rules import apart_members, consider_covariance, velocity_frame
+from tdm.fusion_target import FusedTarget
 from tdm.nav_bias import NAV_RELATIVE_SENSORS, nav_bias_covariance
 
-if TYPE_CHECKING:  # pragma: no cover
-    from tdm.fusion import FusedTarget
 
 __all__ = ["reported_covariance"]
 

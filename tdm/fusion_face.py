@@ -22,17 +22,15 @@ A target with AIS takes its hull's spread instead (:func:`tdm.fusion_weights.wit
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from tdm.fusion_config import FusionConfig
+from tdm.fusion_target import FusedTarget
 from tdm.hull import UNIFORM_VARIANCE_DIVISOR
 from tdm.nav_bias import NAV_RELATIVE_SENSORS, nav_bias_covariance
 from tdm.tracker import Track
 
-if TYPE_CHECKING:  # pragma: no cover
-    from tdm.fusion import FusedTarget
 
 #: Classes of targets that do not move: an ended one is looked for where it was for ``revive_still_s``, and their
 #: radar tracks are moved behind their face.

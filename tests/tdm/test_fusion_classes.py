@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from tdm import ekf
-from tdm.fusion import FusedTarget
+from tdm.fusion_target import FusedTarget
 from tdm.fusion_classes import VESSEL_MOVING_S, VESSEL_SIGMAS, Classifier
 from tdm.fusion_config import FusionConfig
 

@@ -90,7 +90,7 @@ def test_a_radar_track_moved_behind_its_face_is_not_widened_again_in_a_vessels_t
     """``face_covariance`` goes by what ``behind_the_face`` did, not by the target's class at the step's end: a track
     moved (its depth's variance already in its state) adds nothing even in a vessel's target; one not moved adds
     its offset even in an iceberg's; a target with AIS, or an unknown own position, adds nothing."""
-    from tdm.fusion import FusedTarget
+    from tdm.fusion_target import FusedTarget
     from tdm.fusion_face import face_covariance, sight_covariance
 
     config = FusionConfig()

@@ -5,7 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from tdm.fusion import FusedTarget, Fuser, FusionConfig
+from tdm.fusion import Fuser, FusionConfig
+from tdm.fusion_target import FusedTarget
 from tdm.fusion_weights import face_turn_speed_sigma_mps, with_fragments
 
 from .test_fusion import make_track
