@@ -30,7 +30,7 @@ from raysim.recording.jsonl import centre_positions_m, course_and_speed, write_o
 from raysim.recording.staging import StagedDirectory, atomic_path
 from raysim.scenario import Scenario, scenario_to_yaml
 from raysim.second_process import SecondProcess, can_start
-from raysim.sensors.lidar_run import ChunkClaims, join_pcap_parts, render_lidar_later_half
+from raysim.sensors.lidar_run import ChunkClaims, join_pcap_parts, render_lidar, render_lidar_later_half
 from raysim.world import World
 
 TRUTH_RATE_HZ = 10.0  # docs/contracts.md: one truth line per object per 0.1 s
@@ -61,10 +61,15 @@ class RenderContext:
         return self._scene
 
 
-def _render_lidar(ctx: "RenderContext") -> None:
-    from raysim.sensors.lidar import render_lidar
+def _lidar_renderer(ctx: "RenderContext"):
+    """A LiDAR renderer for the world and scene of ``ctx``."""
+    from raysim.sensors.lidar import LidarRenderer
 
-    render_lidar(ctx)
+    return LidarRenderer(ctx.world, ctx.scene())
+
+
+def _render_lidar(ctx: "RenderContext") -> None:
+    render_lidar(_lidar_renderer(ctx), ctx)
 
 
 def _render_radar(ctx: "RenderContext") -> None:
@@ -336,7 +341,7 @@ def _render_sensors(ctx: RenderContext, scenario: Scenario, enabled, progress,
                 step.done = _made(ctx.counts, sorted(set(ctx.counts) - before))
             wall[name] = step.elapsed_s
         if apart:  # the other sensors are done: this process renders the later half of the LiDAR still to do
-            lidar["later_half"] = render_lidar_later_half(ctx, claims)
+            lidar["later_half"] = render_lidar_later_half(_lidar_renderer(ctx), ctx, claims)
     if apart:
         join_pcap_parts(ctx.out_dir / "lidar")
         for key, value in lidar["later_half"].items():

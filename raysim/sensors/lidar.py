@@ -35,8 +35,8 @@ from raysim.sensors import lidar_kernels
 from raysim.sensors import lidar_physics as phys
 from raysim.sensors.blas_threads import single_blas_thread
 from raysim.sensors.carrier import CarrierScene
-from raysim.sensors.context import SensorContext
 from raysim.sensors.lidar_rays import CAST_RANGE_MARGIN_M, LidarGeometry, _Rays
+from raysim.sensors.lidar_run import render_chunks
 from raysim.world import World
 
 SOURCE_OBJECT, SOURCE_SEA, SOURCE_WEATHER = 0, 1, 2
@@ -551,8 +551,6 @@ class LidarRenderer(LidarGeometry):
 
     def run(self, out_dir: Path, progress=None) -> dict:
         """Render the whole scenario into ``out_dir/lidar``; returns counts for the manifest."""
-        from raysim.sensors.lidar_run import render_chunks
-
         return render_chunks(self, out_dir, progress)
 
     def _write_in_order(self, pcap: PcapWriter, payloads: np.ndarray, sent: np.ndarray, position_times: list[float]) -> None:
@@ -569,10 +567,3 @@ class LidarRenderer(LidarGeometry):
             pcap.write_udp(packet, hdl32e.POSITION_PORT, np.array([self.start_unix_s + tp]))
         if cut < payloads.shape[0]:
             pcap.write_udp(payloads[cut:], hdl32e.DATA_PORT, self.start_unix_s + sent[cut:])
-
-
-def render_lidar(ctx: SensorContext) -> None:
-    """The ``lidar`` entry of :data:`raysim.render.SENSOR_RENDERERS` (:func:`raysim.sensors.lidar_run.render_lidar`)."""
-    from raysim.sensors.lidar_run import render_lidar as render
-
-    render(ctx)

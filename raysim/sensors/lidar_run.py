@@ -176,12 +176,10 @@ class ChunkClaims:
             return first, end
 
 
-def render_lidar(ctx: SensorContext) -> None:
-    """The ``lidar`` entry of :data:`raysim.render.SENSOR_RENDERERS` (in a second process: the chunks it
-    may claim, ``ctx.lidar_claims``)."""
-    from raysim.sensors.lidar import LidarRenderer
-
-    renderer = LidarRenderer(ctx.world, ctx.scene())
+def render_lidar(renderer, ctx: SensorContext) -> None:
+    """Render the ``lidar`` entry of :data:`raysim.render.SENSOR_RENDERERS` with ``renderer`` (a
+    :class:`raysim.sensors.lidar.LidarRenderer` made for ``ctx``'s world and scene; in a second process: the chunks
+    it may claim, ``ctx.lidar_claims``)."""
     claims = getattr(ctx, "lidar_claims", None)
     from tqdm import tqdm
 
@@ -190,12 +188,10 @@ def render_lidar(ctx: SensorContext) -> None:
     ctx.counts.update({f"lidar/{k}": v for k, v in counts.items()})
 
 
-def render_lidar_later_half(ctx: SensorContext, claims: ChunkClaims) -> dict:
-    """This process's share of a LiDAR run the second process renders (:meth:`ChunkClaims.take_later_half`):
-    its counts (``lidar/...``), empty when it took nothing."""
-    from raysim.sensors.lidar import LidarRenderer
-
-    renderer = LidarRenderer(ctx.world, ctx.scene())
+def render_lidar_later_half(renderer, ctx: SensorContext, claims: ChunkClaims) -> dict:
+    """This process's share of a LiDAR run the second process renders (:meth:`ChunkClaims.take_later_half`), with
+    ``renderer`` (a :class:`raysim.sensors.lidar.LidarRenderer` made for ``ctx``'s world and scene): its counts
+    (``lidar/...``), empty when it took nothing."""
     first, end = claims.take_later_half(renderer.n_chunks)
     if first >= end:
         return {}
