@@ -31,6 +31,14 @@ def test_velocity_nees_per_sensor_on_a_rendered_recording(bos_recording, tmp_pat
             assert apart[sensor] == whole[sensor]
     assert apart["fused"] != whole["fused"]
     assert all(math.isfinite(v) for m in apart.values() for v in m.values())
+    # still and moving objects split each sensor's states; under, in and over the interval split them again
+    for sensor in ("ais", "lidar", "radar", "fused"):
+        if sensor in apart:
+            parts = [apart[k]["n"] for k in (f"{sensor}, still objects", f"{sensor}, moving objects") if k in apart]
+            assert sum(parts) == apart[sensor]["n"]
+            m = apart[sensor]
+            assert math.isclose(m["under_95"] + m["in_95"] + m["over_95"], 1.0)
+    assert "fused, still objects" in apart and "fused, moving objects" in apart  # busy_open_sea: bergs and ships
     out = tmp_path / "page.md"
     assert bench.main([str(bos_recording), "--out", str(out)]) == 0
     assert "| rec | fused |" in out.read_text()
