@@ -29,6 +29,7 @@ from tdm.association import chi2_gate, gnn_first, mahalanobis2
 from tdm.clutter_areas import ClutterAreas
 from tdm.detections import Detections
 from tdm.echoes import inside_echoes
+from tdm.shadows import across_sight_m, shadowed
 from tdm.tracker_config import STRONG_HIT, TrackerConfig, hit_weight
 
 #: Degrees of freedom of the association gate: east and north position.
@@ -286,13 +287,7 @@ class PositionTracker:
         self._own_m = np.asarray(ownship_position_m, dtype=float)[:2]
         for i, j in pairs:
             self._update(tracks[i], dets, j, cov[j])
-        # misses for tracks that could see their object
-        for i, track in enumerate(tracks):
-            if i in assigned_tracks:
-                continue
-            x_pred = ekf.predict_mean(track.x, t_scan - track.t_s)
-            if np.hypot(*(x_pred[:2] - ownship_position_m)) <= cfg.max_range_m:
-                self._record(track, 0.0)
+        self._record_misses([t for i, t in enumerate(tracks) if i not in assigned_tracks], dets, t_scan)
         for j in range(n_det):
             if j not in assigned_dets:
                 self._initiate(dets, j, cov[j])
@@ -301,6 +296,22 @@ class PositionTracker:
             free = np.ones(n_det, dtype=bool)
             free[list(assigned_dets)] = False  # a plot that no track took: clutter, or an object's first
             self._clutter.update(self._own_m, pos[free])
+
+    def _record_misses(self, missed: list[Track], dets: Detections, t_scan: float) -> None:
+        """A miss for each track of ``missed`` that could see its object at ``t_scan`` (s): within ``max_range_m``
+        and, with ``shadow_misses``, not in the shadow of one of the scan's detections (:func:`tdm.shadows.shadowed`)."""
+        if not missed:
+            return
+        x_pred = np.array([ekf.predict_mean(track.x, t_scan - track.t_s)[:2] for track in missed])
+        seen = np.hypot(*(x_pred - self._own_m).T) <= self.config.max_range_m
+        if self.config.shadow_misses and len(dets):
+            d = dets.position_m - self._own_m
+            across = across_sight_m(dets.length_m, dets.width_m, dets.orientation_deg,
+                                    np.degrees(np.arctan2(d[:, 0], d[:, 1])))
+            seen &= ~shadowed(x_pred, self._own_m, dets.position_m, across)
+        for track, miss in zip(missed, seen):
+            if miss:
+                self._record(track, 0.0)
 
     def confirmed_tracks(self) -> list[Track]:
         return [t for t in self.tracks if t.confirmed]

@@ -106,6 +106,11 @@ class TrackerConfig:
         a LiDAR cluster of an object that may go on beyond it) reports this standard deviation more along the line
         of sight from the own ship, m (:func:`tdm.fusion_face.sensor_report`; a consider term as the extent's, not
         in the filter). 0: none.
+    shadow_misses : bool
+        A track predicted in the shadow of one of the scan's detections (farther than it, within the bearings its
+        extent across the line of sight covers: :func:`tdm.shadows.shadowed`) that gets no detection records no miss:
+        the sensor cannot see there, so it is no evidence against the track (a berg behind a nearer berg). Its coast
+        (``coast_s``) still runs. False (default): every unassigned track within ``max_range_m`` misses.
     course_retry_s : float
         A track whose first two detections were too close for their velocity to tell its course (the two-point
         speed under ``COURSE_SIGMAS`` of its standard deviation) tries again from its first detection to each
@@ -134,6 +139,7 @@ class TrackerConfig:
     weak_rise_from_cells: float = 8.0
     min_beam_fill: float | None = None
     clutter_extra_hits: float = 0.0
+    shadow_misses: bool = False
     clutter_cell_range_m: float = 200.0
     clutter_cell_deg: float = 30.0
     clutter_memory_scans: float = 20.0

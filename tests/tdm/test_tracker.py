@@ -127,6 +127,31 @@ def test_misses_outside_the_sensor_range_do_not_count():
     assert list(track.hits) == hits
 
 
+def test_a_track_in_the_shadow_of_a_nearer_detection_records_no_miss_with_shadow_misses():
+    """A tentative track behind a nearer object (its plot 20 m across, on the same bearing) gets no plot for three
+    scans: with ``shadow_misses`` those scans are not misses, and it is confirmed on its next two hits; without, the
+    three misses end it (3 of 5 can no longer be reached) and the object starts again."""
+    front, back = [0.0, 200.0], [0.0, 300.0]
+    outcomes = {}
+    for shadow in (False, True):
+        cfg = replace(CFG, coast_s=20.0, shadow_misses=shadow)
+        tracker = PositionTracker("radar", cfg)
+        for k in range(2):
+            tracker.process(scan(float(k), [front, back]), np.zeros(2))
+        for k in range(2, 5):  # the back object hidden
+            d = scan(float(k), [front])
+            d.length_m, d.width_m = np.array([20.0]), np.array([20.0])
+            tracker.process(d, np.zeros(2))
+        behind = min(tracker.tracks, key=lambda t: abs(t.x[1] - back[1]))
+        outcomes[shadow] = (list(behind.hits), behind.created_s)
+        for k in range(5, 6):
+            tracker.process(scan(float(k), [front, back]), np.zeros(2))
+        outcomes[shadow] += (any(t.confirmed and abs(t.x[1] - back[1]) < 5.0 for t in tracker.tracks),)
+    assert outcomes[True][:2] == ([1.0, 1.0], 0.0)  # no misses recorded behind the front object
+    assert outcomes[True][2]  # the third hit confirms it
+    assert not outcomes[False][2]  # the misses ended it: a new track on the back object, not yet confirmed
+
+
 def test_a_track_reports_the_uncertainty_of_the_centre_behind_the_side_it_sees():
     """extent_sigma_fraction f: the reported position covariance grows by (f L)^2 per axis, the filter does not."""
     dets = scan(0.0, [[100.0, 200.0]], sigma=1.0)
