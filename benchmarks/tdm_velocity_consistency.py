@@ -15,8 +15,9 @@ evaluation's cut-off), and forms the east-north velocity error ``dv`` and its NE
 the covariance turned to east and north velocity, :func:`tdm.fusion_rules.to_cartesian`). Per sensor, over every
 matched state and apart for states matched to still objects (truth under ``STILL_MPS``) and to moving ones: the mean
 NEES (2 for a consistent one), the fractions in its 95 % interval, under it (the sensor claims less than it does) and
-over it, the rms and the median absolute velocity error against the median reported standard deviation per axis. ``--whole``: each recording a second time with every member fused whole
-(``FusionConfig.fuse_position_apart`` empty, the rule until 2026-11-29), beside.
+over it, the rms and the median absolute velocity error against the median reported standard deviation per axis.
+``--whole``: each recording a second time with every member fused whole (``FusionConfig.fuse_position_apart``
+empty, the rule until 2026-11-29), beside.
 """
 
 from __future__ import annotations
@@ -115,8 +116,10 @@ def _truth_at(truth: dict, names: list, t_s: np.ndarray) -> tuple[np.ndarray, np
 
 
 def velocity_nees(recording: Path, whole: bool = False) -> dict[str, dict[str, float]]:
-    """Per sensor (and ``fused``): ``n``, ``nees_mean``, ``in_95``, ``rms_error_mps`` (per axis) and
-    ``reported_sd_mps`` (median, per axis) over the matched weighed states of ``recording`` (``whole``:
+    """Per sensor (and ``fused``), keyed by its name, and apart for the states matched to still and to moving truth
+    objects (``"<sensor>, still objects"``, ``"<sensor>, moving objects"``; a key only where there are such states):
+    ``n``, ``nees_mean``, ``in_95``, ``under_95``, ``over_95``, ``rms_error_mps`` and ``median_error_mps`` (per axis)
+    and ``reported_sd_mps`` (median, per axis) over the matched weighed states of ``recording`` (``whole``:
     :func:`weighed_states`)."""
     t, sensor, x, p, frame = weighed_states(recording, whole)
     truth, _ = read_truth_samples(recording / "truth.jsonl")
@@ -138,7 +141,8 @@ def velocity_nees(recording: Path, whole: bool = False) -> dict[str, dict[str, f
     still = np.hypot(*vel[rows, nearest].T) < STILL_MPS
     out = {}
     for name in SENSORS:
-        for part, objects in (("", matched), (", still objects", matched & still), (", moving objects", matched & ~still)):
+        parts = (("", matched), (", still objects", matched & still), (", moving objects", matched & ~still))
+        for part, objects in parts:
             sel = objects & (sensor == name) & np.isfinite(value)
             if sel.any():
                 out[name + part] = _consistency(value[sel], dv[sel], qv[sel])

@@ -16,7 +16,7 @@ import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Iterator
+from typing import TYPE_CHECKING, Callable, Iterator
 
 import numpy as np
 from tqdm import tqdm
@@ -32,6 +32,9 @@ from raysim.scenario import Scenario, scenario_to_yaml
 from raysim.second_process import SecondProcess, can_start
 from raysim.sensors.lidar_run import ChunkClaims, join_pcap_parts, render_lidar, render_lidar_later_half
 from raysim.world import World
+
+if TYPE_CHECKING:  # pragma: no cover (the renderer loads Open3D: imported when a LiDAR renders)
+    from raysim.sensors.lidar import LidarRenderer
 
 TRUTH_RATE_HZ = 10.0  # docs/contracts.md: one truth line per object per 0.1 s
 CHUNK_S = 30.0  # seconds of truth / navigation formatted at a time (memory stays flat)
@@ -61,7 +64,7 @@ class RenderContext:
         return self._scene
 
 
-def _lidar_renderer(ctx: "RenderContext"):
+def _lidar_renderer(ctx: "RenderContext") -> "LidarRenderer":
     """A LiDAR renderer for the world and scene of ``ctx``."""
     from raysim.sensors.lidar import LidarRenderer
 

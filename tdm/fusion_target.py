@@ -1,9 +1,9 @@
 """What the fusion hands on: a detected target (:class:`FusedTarget`, the per-sensor tracks of one object) and its
 fused state at one time (:class:`FusedEstimate`).
 
-The fuser (:mod:`tdm.fusion`) makes and keeps them; the modules that weigh and report them
-(:mod:`tdm.fusion_face`, :mod:`tdm.fusion_consider`) read them. They live here, under all three, so that none of those
-imports another for its types.
+The fuser (:mod:`tdm.fusion`) makes and keeps them; the modules that classify, weigh and report them
+(:mod:`tdm.fusion_classes`, :mod:`tdm.fusion_weights`, :mod:`tdm.fusion_face`, :mod:`tdm.fusion_consider`) read them.
+They live here, under all of these, so that none imports the fuser for its types.
 """
 
 from __future__ import annotations

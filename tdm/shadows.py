@@ -4,42 +4,61 @@ track predicted there missing its detection is no evidence against it (:class:`t
 
 Neither the LiDAR's light nor the radar's microwaves go through an iceberg or a hull: an object behind another, as
 the sensor looks, returns nothing while it stays in that shadow. A detection's shadow is the sector of bearings its
-extent across the line of sight covers, beyond its range.
+extent across the line of sight covers, beyond its far side (its centre plus half its extent along the line of
+sight, so that a track just behind its own object's plot is not hidden by it). A detection that holds the sensor
+(nearer than half its extent across the line of sight) casts none.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["across_sight_m", "shadowed"]
+__all__ = ["box_extents_m", "shadowed"]
 
 
-def across_sight_m(length_m: np.ndarray, width_m: np.ndarray, orientation_deg: np.ndarray,
-                   sight_deg: np.ndarray) -> np.ndarray:
-    """(N,) extent across the line of sight of boxes ``length_m`` x ``width_m`` (N,) whose long side lies at
-    ``orientation_deg`` (N,) (compass degrees), seen along ``sight_deg`` (N,) (compass degrees from the sensor), m:
-    ``L |sin a| + W |cos a|``, ``a`` the angle between the long side and the line of sight; 0 where a size is not
-    finite."""
+def box_extents_m(length_m: np.ndarray, width_m: np.ndarray, orientation_deg: np.ndarray,
+                  sight_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Extents across and along the line of sight of boxes ``length_m`` x ``width_m`` (N,) whose long side lies at
+    ``orientation_deg`` (N,) (compass degrees), seen along ``sight_deg`` (N,) (compass degrees from the sensor).
+
+    Returns
+    -------
+    across_m, along_m : (N,) float
+        ``L |sin a| + W |cos a|`` and ``L |cos a| + W |sin a|``, m, ``a`` the angle between the long side and the line
+        of sight; where the orientation is not finite, the length both ways (the box's largest extent); 0 where a size
+        is not finite.
+    """
+    length_m, width_m = np.asarray(length_m, dtype=float), np.asarray(width_m, dtype=float)
     a = np.radians(np.asarray(orientation_deg, dtype=float) - np.asarray(sight_deg, dtype=float))
-    out = np.abs(length_m * np.sin(a)) + np.abs(width_m * np.cos(a))
-    return np.where(np.isfinite(out), out, 0.0)
+    sin_a, cos_a = np.abs(np.sin(a)), np.abs(np.cos(a))
+    across = length_m * sin_a + width_m * cos_a
+    along = length_m * cos_a + width_m * sin_a
+    unknown = ~np.isfinite(a)
+    across, along = np.where(unknown, length_m, across), np.where(unknown, length_m, along)
+    return np.where(np.isfinite(across), across, 0.0), np.where(np.isfinite(along), along, 0.0)
 
 
-def shadowed(position_m: np.ndarray, own_m: np.ndarray, det_position_m: np.ndarray,
-             det_across_m: np.ndarray) -> np.ndarray:
+def shadowed(position_m: np.ndarray, own_m: np.ndarray, det_position_m: np.ndarray, det_across_m: np.ndarray,
+             det_along_m: np.ndarray) -> np.ndarray:
     """(K,) bool: which of ``position_m`` (K, 2) (east, north, m) lie in the shadow of a detection at
-    ``det_position_m`` (N, 2) of extent ``det_across_m`` (N,) across the line of sight (:func:`across_sight_m`), seen
-    from ``own_m`` (2,): farther from the sensor than the detection and within the bearings its extent covers,
-    ``|bearing - bearing_j| <= atan(det_across_m / 2 / range_j)``."""
+    ``det_position_m`` (N, 2) of extents ``det_across_m`` and ``det_along_m`` (N,) across and along the line of sight
+    (:func:`box_extents_m`), m, seen from ``own_m`` (2,): farther from the sensor than the detection's far side,
+    ``range > range_j + det_along_m / 2``, and within the bearings its extent covers,
+    ``|bearing - bearing_j| <= atan(det_across_m / 2 / range_j)``; a detection with ``range_j <= det_across_m / 2``
+    (the sensor within its extent) casts none."""
     position_m = np.asarray(position_m, dtype=float).reshape(-1, 2)
     det_position_m = np.asarray(det_position_m, dtype=float).reshape(-1, 2)
-    if position_m.shape[0] == 0 or det_position_m.shape[0] == 0:
-        return np.zeros(position_m.shape[0], dtype=bool)
+    half_across = 0.5 * np.asarray(det_across_m, dtype=float)
     t = position_m - own_m
     d = det_position_m - own_m
-    range_t, range_d = np.hypot(t[:, 0], t[:, 1]), np.hypot(d[:, 0], d[:, 1])
-    half_rad = np.arctan2(0.5 * np.asarray(det_across_m, dtype=float), range_d)
+    range_d = np.hypot(d[:, 0], d[:, 1])
+    casts = range_d > half_across
+    if position_m.shape[0] == 0 or not casts.any():
+        return np.zeros(position_m.shape[0], dtype=bool)
+    d, range_d, half_across = d[casts], range_d[casts], half_across[casts]
+    far_side = range_d + 0.5 * np.asarray(det_along_m, dtype=float)[casts]
+    half_rad = np.arctan2(half_across, range_d)
     off = np.arctan2(t[:, 0], t[:, 1])[:, None] - np.arctan2(d[:, 0], d[:, 1])[None, :]
     off = (off + np.pi) % (2.0 * np.pi) - np.pi
-    behind = (range_t[:, None] > range_d[None, :]) & (np.abs(off) <= half_rad[None, :])
+    behind = (np.hypot(t[:, 0], t[:, 1])[:, None] > far_side[None, :]) & (np.abs(off) <= half_rad[None, :])
     return behind.any(axis=1)

@@ -128,10 +128,11 @@ def test_misses_outside_the_sensor_range_do_not_count():
 
 
 def test_a_track_in_the_shadow_of_a_nearer_detection_records_no_miss_with_shadow_misses():
-    """A tentative track behind a nearer object (its plot 20 m across, on the same bearing) gets no plot for three
-    scans: with ``shadow_misses`` those scans are not misses, and it is confirmed on its next two hits; without, the
-    three misses end it (3 of 5 can no longer be reached) and the object starts again."""
-    front, back = [0.0, 200.0], [0.0, 300.0]
+    """A tentative track behind a nearer object (its plot 20 m across, 1.1 deg off the plot's bearing, within the
+    2.9 deg its half width covers at 200 m) gets no plot for three scans: with ``shadow_misses`` those scans are not
+    misses, and it is confirmed on its next hit; without, the three misses end it (3 of 5 can no longer be reached)
+    and the object starts again."""
+    front, back = [0.0, 200.0], [6.0, 300.0]
     outcomes = {}
     for shadow in (False, True):
         cfg = replace(CFG, coast_s=20.0, shadow_misses=shadow)
