@@ -38,27 +38,27 @@ def box_extents_m(length_m: np.ndarray, width_m: np.ndarray, orientation_deg: np
     return np.where(np.isfinite(across), across, 0.0), np.where(np.isfinite(along), along, 0.0)
 
 
-def shadowed(position_m: np.ndarray, own_m: np.ndarray, det_position_m: np.ndarray, det_across_m: np.ndarray,
-             det_along_m: np.ndarray) -> np.ndarray:
+def shadowed(position_m: np.ndarray, own_m: np.ndarray, det_position_m: np.ndarray, det_length_m: np.ndarray,
+             det_width_m: np.ndarray, det_orientation_deg: np.ndarray) -> np.ndarray:
     """(K,) bool: which of ``position_m`` (K, 2) (east, north, m) lie in the shadow of a detection at
-    ``det_position_m`` (N, 2) of extents ``det_across_m`` and ``det_along_m`` (N,) across and along the line of sight
-    (:func:`box_extents_m`), m, seen from ``own_m`` (2,): farther from the sensor than the detection's far side,
-    ``range > range_j + det_along_m / 2``, and within the bearings its extent covers,
-    ``|bearing - bearing_j| <= atan(det_across_m / 2 / range_j)``; a detection with ``range_j <= det_across_m / 2``
-    (the sensor within its extent) casts none."""
+    ``det_position_m`` (N, 2), its box ``det_length_m`` x ``det_width_m`` (N,) m with its long side at
+    ``det_orientation_deg`` (N,) (compass degrees), seen from ``own_m`` (2,): farther from the sensor than the
+    detection's far side, ``range > range_j + along_j / 2``, and within the bearings its extent covers,
+    ``|bearing - bearing_j| <= atan(across_j / 2 / range_j)`` (``across_j``, ``along_j``: :func:`box_extents_m` along
+    the line of sight to it); a detection with ``range_j <= across_j / 2`` (the sensor within its extent) casts none."""
     position_m = np.asarray(position_m, dtype=float).reshape(-1, 2)
-    det_position_m = np.asarray(det_position_m, dtype=float).reshape(-1, 2)
-    half_across = 0.5 * np.asarray(det_across_m, dtype=float)
-    t = position_m - own_m
-    d = det_position_m - own_m
+    d = np.asarray(det_position_m, dtype=float).reshape(-1, 2) - own_m
+    sight_rad = np.arctan2(d[:, 0], d[:, 1])
+    across, along = box_extents_m(det_length_m, det_width_m, det_orientation_deg, np.degrees(sight_rad))
     range_d = np.hypot(d[:, 0], d[:, 1])
-    casts = range_d > half_across
+    casts = range_d > 0.5 * across
     if position_m.shape[0] == 0 or not casts.any():
         return np.zeros(position_m.shape[0], dtype=bool)
-    d, range_d, half_across = d[casts], range_d[casts], half_across[casts]
-    far_side = range_d + 0.5 * np.asarray(det_along_m, dtype=float)[casts]
-    half_rad = np.arctan2(half_across, range_d)
-    off = np.arctan2(t[:, 0], t[:, 1])[:, None] - np.arctan2(d[:, 0], d[:, 1])[None, :]
+    t = position_m - own_m
+    range_d, sight_rad = range_d[casts], sight_rad[casts]
+    far_side = range_d + 0.5 * along[casts]
+    half_rad = np.arctan2(0.5 * across[casts], range_d)
+    off = np.arctan2(t[:, 0], t[:, 1])[:, None] - sight_rad[None, :]
     off = (off + np.pi) % (2.0 * np.pi) - np.pi
     behind = (np.hypot(t[:, 0], t[:, 1])[:, None] > far_side[None, :]) & (np.abs(off) <= half_rad[None, :])
     return behind.any(axis=1)

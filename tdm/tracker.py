@@ -29,7 +29,7 @@ from tdm.association import chi2_gate, gnn_first, mahalanobis2
 from tdm.clutter_areas import ClutterAreas
 from tdm.detections import Detections
 from tdm.echoes import inside_echoes
-from tdm.shadows import box_extents_m, shadowed
+from tdm.shadows import shadowed
 from tdm.tracker_config import STRONG_HIT, TrackerConfig, hit_weight
 
 #: Degrees of freedom of the association gate: east and north position.
@@ -306,10 +306,7 @@ class PositionTracker:
         x_pred = np.array([ekf.predict_mean(track.x, t_scan - track.t_s)[:2] for track in missed])
         seen = np.hypot(*(x_pred - self._own_m).T) <= self.config.max_range_m
         if self.config.shadow_misses and len(dets):
-            d = dets.position_m - self._own_m
-            across, along = box_extents_m(dets.length_m, dets.width_m, dets.orientation_deg,
-                                          np.degrees(np.arctan2(d[:, 0], d[:, 1])))
-            seen &= ~shadowed(x_pred, self._own_m, dets.position_m, across, along)
+            seen &= ~shadowed(x_pred, self._own_m, dets.position_m, dets.length_m, dets.width_m, dets.orientation_deg)
         for track, miss in zip(missed, seen):
             if miss:
                 self._record(track, 0.0)

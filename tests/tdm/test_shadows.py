@@ -19,15 +19,16 @@ def test_a_box_shows_its_side_facing_the_sensor_across_the_sight_and_the_other_a
 
 def test_a_position_is_shadowed_only_beyond_the_far_side_and_within_the_bearings():
     own = np.array([100.0, -50.0])
-    det = own + np.array([[0.0, 200.0]])  # 200 m north of the sensor, 20 m across (+-atan(10 / 200)), 30 m deep
+    det = own + np.array([[0.0, 200.0]])  # 200 m north of the sensor, 20 m across (+-atan(10 / 200)), 30 m deep:
+    # a 30 x 20 m box, its long side north-south along the line of sight
     half = np.arctan2(10.0, 200.0)
     behind_in = own + 300.0 * np.array([np.sin(0.9 * half), np.cos(0.9 * half)])
     behind_out = own + 300.0 * np.array([np.sin(1.1 * half), np.cos(1.1 * half)])
     within_depth = own + np.array([0.0, 212.0])  # behind the centre but not the far side (215 m): its own object
     nearer = own + 150.0 * np.array([0.0, 1.0])
     other_side = own + np.array([0.0, -300.0])
-    got = shadowed(np.array([behind_in, behind_out, within_depth, nearer, other_side]), own, det, np.array([20.0]),
-                   np.array([30.0]))
+    got = shadowed(np.array([behind_in, behind_out, within_depth, nearer, other_side]), own, det, np.array([30.0]),
+                   np.array([20.0]), np.zeros(1))
     assert got.tolist() == [True, False, False, False, False]
 
 
@@ -35,10 +36,11 @@ def test_bearings_wrap_at_south_and_a_detection_holding_the_sensor_hides_nothing
     own = np.zeros(2)
     det = np.array([[1.0, -100.0]])  # just east of south: bearing 179.4 deg
     target = np.array([[-2.0, -300.0]])  # just west of south, -179.6 deg: 1.0 deg away across the wrap
-    assert shadowed(target, own, det, np.array([10.0]), np.array([10.0])).tolist() == [True]
-    assert shadowed(target, own, np.zeros((0, 2)), np.zeros(0), np.zeros(0)).tolist() == [False]
-    assert shadowed(np.zeros((0, 2)), own, det, np.array([10.0]), np.array([10.0])).shape == (0,)
+    ten = (np.array([10.0]), np.array([10.0]), np.zeros(1))  # a 10 m square
+    assert shadowed(target, own, det, *ten).tolist() == [True]
+    assert shadowed(target, own, np.zeros((0, 2)), np.zeros(0), np.zeros(0), np.zeros(0)).tolist() == [False]
+    assert shadowed(np.zeros((0, 2)), own, det, *ten).shape == (0,)
     # a plot on the own ship (a range of 0, under half its extent) would otherwise hide half the sea
     far = np.array([[500.0, 500.0], [-500.0, 500.0], [0.0, -500.0]])
-    assert not shadowed(far, own, np.array([[0.0, 0.0], [1.0, 2.0]]), np.array([10.0, 10.0]),
-                        np.array([10.0, 10.0])).any()
+    assert not shadowed(far, own, np.array([[0.0, 0.0], [1.0, 2.0]]), np.array([10.0, 10.0]), np.array([10.0, 10.0]),
+                        np.zeros(2)).any()
