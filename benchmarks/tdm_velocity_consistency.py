@@ -35,11 +35,11 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
 from benchmarks.common import machine_line  # noqa: E402
-from groundfloor.frames import LocalFrame  # noqa: E402
 import tdm.pipeline as pipeline  # noqa: E402
 from tdm.eval_scoring import NEES_95_INTERVAL  # noqa: E402
-from tdm.eval_truth import read_truth_samples  # noqa: E402
+from tdm.eval_truth import read_truth_enu, truth_at  # noqa: E402
 from tdm.fusion import Fuser  # noqa: E402
+from tdm.frames import EnuFrame  # noqa: E402
 from tdm.fusion_rules import to_cartesian  # noqa: E402
 
 #: A state is matched to the nearest truth object within this, m (the evaluation's cut-off, tdm/evaluate.py).
@@ -65,7 +65,7 @@ class _RecordingFuser(Fuser):
 
 
 def weighed_states(recording: Path, whole: bool = False
-                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, LocalFrame]:
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, EnuFrame]:
     """Run the TDM on ``recording`` (``whole``: with ``FusionConfig.fuse_position_apart`` empty) and return the
     weighed states: times (R,) s, sensors (R,) str, states (R, 6), covariances (R, 6, 6), in the TDM's frame
     (returned too).
@@ -97,24 +97,6 @@ def weighed_states(recording: Path, whole: bool = False
     return t, np.array([r[1] for r in rows]), np.array([r[2] for r in rows]), np.array([r[3] for r in rows]), frames[0]
 
 
-def _truth_at(truth: dict, names: list, t_s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(R, K, 2) positions and (R, K, 2) velocities east and north of the truth objects ``names`` at ``t_s`` (NaN
-    outside each object's samples)."""
-    pos = np.full((t_s.size, len(names), 2), np.nan)
-    vel = np.full_like(pos, np.nan)
-    for k, name in enumerate(names):
-        sel = truth["name"] == name
-        order = np.argsort(truth["t"][sel])
-        ts = truth["t"][sel][order]
-        cog = np.radians(truth["cog_deg"][sel][order])
-        sog = truth["sog_mps"][sel][order]
-        for col, values in enumerate((truth["east_m"][sel][order], truth["north_m"][sel][order])):
-            pos[:, k, col] = np.interp(t_s, ts, values, left=np.nan, right=np.nan)
-        for col, values in enumerate((sog * np.sin(cog), sog * np.cos(cog))):
-            vel[:, k, col] = np.interp(t_s, ts, values, left=np.nan, right=np.nan)
-    return pos, vel
-
-
 def velocity_nees(recording: Path, whole: bool = False) -> dict[str, dict[str, float]]:
     """Per sensor (and ``fused``), keyed by its name, and apart for the states matched to still and to moving truth
     objects (``"<sensor>, still objects"``, ``"<sensor>, moving objects"``; a key only where there are such states):
@@ -122,13 +104,13 @@ def velocity_nees(recording: Path, whole: bool = False) -> dict[str, dict[str, f
     and ``reported_sd_mps`` (median, per axis) over the matched weighed states of ``recording`` (``whole``:
     :func:`weighed_states`)."""
     t, sensor, x, p, frame = weighed_states(recording, whole)
-    truth, _ = read_truth_samples(recording / "truth.jsonl")
-    own = int(np.flatnonzero(truth["kind"] == "ownship")[0])
-    truth_frame = LocalFrame(truth["lat"][own], truth["lon"][own])
-    truth["east_m"], truth["north_m"] = truth_frame.to_local(truth["lat"], truth["lon"])
+    epochs, row = np.unique(t, return_inverse=True)
+    truth_frame, truth = read_truth_enu(recording)
+    at = truth_at(truth, epochs)  # (E, K) per truth object, NaN where it has no samples
     east, north = truth_frame.to_local(*frame.to_geodetic(x[:, 0], x[:, 1]))
-    names = sorted(set(truth["name"][truth["kind"] != "ownship"].tolist()))
-    pos, vel = _truth_at(truth, names, t)
+    cog_rad = np.radians(at.cog_deg)
+    pos = np.stack([at.east_m, at.north_m], axis=-1)[row]
+    vel = np.stack([at.sog_mps * np.sin(cog_rad), at.sog_mps * np.cos(cog_rad)], axis=-1)[row]
     dist = np.hypot(pos[..., 0] - east[:, None], pos[..., 1] - north[:, None])
     dist = np.where(np.isfinite(dist), dist, np.inf)
     nearest = np.argmin(dist, axis=1)
