@@ -38,8 +38,8 @@ from benchmarks.common import machine_line  # noqa: E402
 import tdm.pipeline as pipeline  # noqa: E402
 from tdm.eval_scoring import NEES_95_INTERVAL  # noqa: E402
 from tdm.eval_truth import read_truth_enu, truth_at  # noqa: E402
-from tdm.fusion import Fuser  # noqa: E402
 from tdm.frames import EnuFrame  # noqa: E402
+from tdm.fusion import Fuser  # noqa: E402
 from tdm.fusion_rules import to_cartesian  # noqa: E402
 
 #: A state is matched to the nearest truth object within this, m (the evaluation's cut-off, tdm/evaluate.py).
